@@ -1,0 +1,28 @@
+// simgrass: the SimGrass testbed's command-line tool.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <string>
+
+#include "replay/cli/run_command.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"SimGrass: deterministic fixed-point grass physics testbed", "simgrass"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("simgrass ") + SIMGRASS_VERSION);
+  int exitCode = 0;
+  sg::addRunCommand(app, &exitCode);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // One line, non-zero: the command-line counterpart of a bad scenario.
+    std::fprintf(stderr, "simgrass: %s (see 'simgrass --help')\n", e.what());
+    return 2;
+  }
+  return exitCode;
+}

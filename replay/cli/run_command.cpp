@@ -1,0 +1,141 @@
+#include "replay/cli/run_command.h"
+
+#include <chrono>
+#include <cinttypes>
+#include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "replay/progress.h"
+#include "replay/scenario_files.h"
+#include "replay/stage_clock.h"
+#include "sim/world/world.h"
+
+namespace sg {
+namespace {
+struct RunOptions {
+  std::string scenario;
+  int64_t ticks = 600;
+  std::string scalar;
+  int interp = 0;
+  int threads = 1;
+  int64_t hashEvery = 0;
+  bool json = false;
+};
+
+std::string hex(uint64_t h) {
+  char buf[19];
+  std::snprintf(buf, sizeof buf, "%016" PRIx64, h);
+  return buf;
+}
+
+int runScenario(const RunOptions& o) {
+  Scenario scenario;
+  std::unique_ptr<SimWorld> world;
+  try {
+    scenario = loadScenarioFile(o.scenario);
+    if (!o.scalar.empty()) scenario.scalar = *parseScalarKind(o.scalar);
+    if (o.interp > 0) scenario.particles.interpolation = o.interp;
+    world = makeWorld(scenario, o.threads, physicalMemoryBytes());
+  } catch (const ScenarioError& e) {
+    std::fprintf(stderr, "simgrass run: %s\n", e.what());
+    return 2;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "simgrass run: %s: $.field: expected a field that fits in memory (allocation failed)\n",
+                 o.scenario.empty() ? "<built-in>" : o.scenario.c_str());
+    return 2;
+  }
+  const WorldCounts counts = world->counts();
+  StageClock clock;
+  nlohmann::json hashes = nlohmann::json::array();
+  ProgressBar progress("run", o.ticks, !o.json);
+  const TickInput input;
+  const auto start = std::chrono::steady_clock::now();
+  StepResult failure;
+  for (int64_t t = 0; t < o.ticks; ++t) {
+    StepResult r = world->step(input, &clock);
+    if (!r.ok) {
+      failure = r;
+      break;
+    }
+    if (o.hashEvery > 0 && world->tick() % o.hashEvery == 0) {
+      const std::string h = hex(world->stateHash());
+      if (o.json) {
+        hashes.push_back({{"tick", world->tick()}, {"hash", h}});
+      } else {
+        progress.finish();
+        std::printf("tick %-8" PRId64 " hash %s\n", world->tick(), h.c_str());
+      }
+    }
+    progress.update(t + 1);
+  }
+  progress.finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const int64_t ran = world->tick();
+  const uint64_t finalHash = world->stateHash();
+  const double msPerTick = ran > 0 ? seconds * 1e3 / double(ran) : 0.0;
+  const double patchSteps = ran > 0 ? double(counts.patches()) * double(ran) / seconds : 0.0;
+
+  if (o.json) {
+    nlohmann::json j;
+    j["scenario"] = scenario.name;
+    j["source"] = scenario.sourceName;
+    j["scalar"] = scalarName(scenario.scalar);
+    j["interpolation"] = counts.interpolation;
+    j["threads"] = counts.threads;
+    j["counts"] = {{"patchesX", counts.patchesX}, {"patchesZ", counts.patchesZ}, {"patches", counts.patches()},
+                   {"particlesX", counts.particlesX}, {"particlesZ", counts.particlesZ},
+                   {"particles", counts.particles()}};
+    j["ticks"] = ran;
+    j["finalHash"] = hex(finalHash);
+    if (o.hashEvery > 0) j["hashes"] = hashes;
+    nlohmann::json stages = nlohmann::json::object();
+    for (size_t s = 0; s < size_t(Stage::Count); ++s)
+      stages[stageName(Stage(s))] = ran > 0 ? double(clock.nanos[s]) / 1e6 / double(ran) : 0.0;
+    j["timing"] = {{"seconds", seconds}, {"msPerTick", msPerTick}, {"patchStepsPerSecond", patchSteps},
+                   {"stageMsPerTick", stages}};
+    if (!failure.ok) j["error"] = failure.error.message();
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    std::printf("scenario   %s (%s)\n", scenario.name.c_str(), scenario.sourceName.c_str());
+    std::printf("scalar     %s, interpolation k=%d, %d thread%s\n", scalarName(scenario.scalar), counts.interpolation,
+                counts.threads, counts.threads == 1 ? "" : "s");
+    std::printf("patches    %" PRId64 " (%" PRId64 " x %" PRId64 "), particles %" PRId64 " (%" PRId64 " x %" PRId64 ")\n",
+                counts.patches(), counts.patchesX, counts.patchesZ, counts.particles(), counts.particlesX,
+                counts.particlesZ);
+    std::printf("ticks      %" PRId64 " (%.3f s simulated at dt = %s s)\n", ran,
+                double(ran) * scenario.timeStep.toDouble(), scenario.timeStep.toString().c_str());
+    std::printf("hash       %s (state after tick %" PRId64 ")\n", hex(finalHash).c_str(), ran);
+    std::printf("time       %.1f ms total, %.3f ms/tick, %.1f M patch-steps/s\n", seconds * 1e3, msPerTick,
+                patchSteps / 1e6);
+    std::printf("stages     ");
+    for (size_t s = 0; s < size_t(Stage::Count); ++s)
+      std::printf("%s %.3f  ", stageName(Stage(s)), ran > 0 ? double(clock.nanos[s]) / 1e6 / double(ran) : 0.0);
+    std::printf("(ms/tick)\n");
+  }
+  if (!failure.ok) {
+    std::fprintf(stderr, "simgrass run: %s\n", failure.error.message().c_str());
+    return 1;
+  }
+  return 0;
+}
+}  // namespace
+
+void addRunCommand(CLI::App& app, int* exitCode) {
+  auto opts = std::make_shared<RunOptions>();
+  CLI::App* run = app.add_subcommand("run", "Run a scenario headless and print the final state hash, timings and counts");
+  run->add_option("scenario", opts->scenario, "Scenario JSON file (default: the built-in thesis meadow)");
+  run->add_option("--ticks", opts->ticks, "Number of fixed ticks to run")->check(CLI::Range(int64_t(0), int64_t(1) << 40));
+  run->add_option("--scalar", opts->scalar, "Scalar type, overriding the scenario")
+      ->check(CLI::IsMember({"fx32", "fx16", "float", "double"}));
+  run->add_option("--interp", opts->interp, "Interpolation k (1 = one particle per patch, 2 = per 2x2, ...)")
+      ->check(CLI::Range(1, 4));
+  run->add_option("--threads", opts->threads, "Worker threads (the result is identical for any count)")
+      ->check(CLI::Range(1, 256));
+  run->add_option("--hash-every", opts->hashEvery, "Also print the state hash every N ticks")
+      ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
+  run->add_flag("--json", opts->json, "Machine-readable output");
+  run->callback([opts, exitCode] { *exitCode = runScenario(*opts); });
+}
+}  // namespace sg

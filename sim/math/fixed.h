@@ -1,0 +1,230 @@
+// Fixed-point scalars for the deterministic core.
+//
+//   Fx32 = Q32.32 in int64_t, products and quotients in __int128 (the reference scalar).
+//   Fx16 = Q16.16 in int32_t, products and quotients in int64_t  (the fast variant).
+//
+// Rounding (documented in docs/fixed-point.md, tested against exact references):
+//   * a * b, a / b and sqrt(a) round to nearest; exact ties round away from zero. This makes
+//     (-a) * b == -(a * b) and (-a) / b == -(a / b), so mirror-symmetric scenes stay symmetric.
+//   * + and - are exact.
+// Overflow is never undefined behaviour: every operation computes in a wider or builtin-checked
+// type. A result that does not fit raises a sticky per-thread fault bit (see FixedFault) and
+// returns the wrapped value; the world's step checks the bits after each particle and turns a
+// fault into a reported simulation error (tick, stage, particle).
+#pragma once
+
+#include <compare>
+#include <cstdint>
+#include <limits>
+#include <type_traits>
+
+namespace sg {
+
+/// Sticky fault bits raised by fixed-point operations on the current thread.
+enum FixedFault : uint32_t {
+  kFixedFaultNone = 0,
+  kFixedFaultOverflow = 1,      ///< a result did not fit the format
+  kFixedFaultDivideByZero = 2,  ///< x / 0
+  kFixedFaultDomain = 4,        ///< sqrt of a negative number
+};
+
+namespace detail {
+// __thread (not thread_local): trivially initialised, so no TLS wrapper call on access.
+extern __thread uint32_t tlsFixedFaults __attribute__((tls_model("initial-exec")));
+[[gnu::cold, gnu::noinline]] void raiseFixedFault(uint32_t fault) noexcept;
+}  // namespace detail
+
+/// Fault bits raised on this thread since the last takeFixedFaults().
+inline uint32_t pendingFixedFaults() noexcept { return detail::tlsFixedFaults; }
+/// Returns and clears this thread's fault bits.
+inline uint32_t takeFixedFaults() noexcept {
+  const uint32_t f = detail::tlsFixedFaults;
+  detail::tlsFixedFaults = 0;
+  return f;
+}
+/// Human-readable name of the most significant fault bit ("overflow", ...).
+const char* fixedFaultName(uint32_t faults) noexcept;
+
+/// Integer square roots, exact: floor variant and round-to-nearest variant.
+uint64_t isqrtFloor(unsigned __int128 n) noexcept;
+inline uint64_t isqrtNearest(unsigned __int128 n) noexcept {
+  const uint64_t r = isqrtFloor(n);
+  // (r + 1/2)^2 = r^2 + r + 1/4, so n rounds up exactly when n - r^2 > r (no ties for integers).
+  return (n - static_cast<unsigned __int128>(r) * r > r) ? r + 1 : r;
+}
+
+template <class Raw, class Wide, int Frac>
+class Fixed {
+  static_assert(std::is_signed_v<Raw> && sizeof(Wide) == 2 * sizeof(Raw));
+  static constexpr int kRawBits = int(sizeof(Raw) * 8);
+
+ public:
+  using RawType = Raw;
+  using WideType = Wide;
+  static constexpr int kFracBits = Frac;
+  static constexpr Raw kOneRaw = Raw(1) << Frac;
+
+  constexpr Fixed() noexcept = default;
+  /// Exact conversion from an integer; raises an overflow fault when it does not fit.
+  template <class I, std::enable_if_t<std::is_integral_v<I> && !std::is_same_v<I, bool>, int> = 0>
+  constexpr Fixed(I value) noexcept  // NOLINT: implicit, so Eigen's Scalar(0), v * 2 work
+      : raw_(fromInteger(value)) {}
+
+  static constexpr Fixed fromRaw(Raw raw) noexcept {
+    Fixed f;
+    f.raw_ = raw;
+    return f;
+  }
+  constexpr Raw raw() const noexcept { return raw_; }
+
+  /// For reports, plots and tests only; never used inside the step.
+  constexpr double toDouble() const noexcept { return double(raw_) / double(kOneRaw); }
+  /// For tests and tools only: nearest representable value (ties away from zero).
+  static Fixed fromDouble(double v) noexcept;
+
+  static constexpr Fixed max() noexcept { return fromRaw(std::numeric_limits<Raw>::max()); }
+  static constexpr Fixed min() noexcept { return fromRaw(std::numeric_limits<Raw>::min()); }
+  static constexpr Fixed epsilon() noexcept { return fromRaw(1); }
+
+  friend constexpr Fixed operator+(Fixed a, Fixed b) noexcept {
+    Raw r;
+    if (__builtin_add_overflow(a.raw_, b.raw_, &r)) detail::raiseFixedFault(kFixedFaultOverflow);
+    return fromRaw(r);
+  }
+  friend constexpr Fixed operator-(Fixed a, Fixed b) noexcept {
+    Raw r;
+    if (__builtin_sub_overflow(a.raw_, b.raw_, &r)) detail::raiseFixedFault(kFixedFaultOverflow);
+    return fromRaw(r);
+  }
+  friend constexpr Fixed operator-(Fixed a) noexcept { return Fixed() - a; }
+  friend constexpr Fixed operator+(Fixed a) noexcept { return a; }
+
+  friend constexpr Fixed operator*(Fixed a, Fixed b) noexcept {
+    // |a*b| <= 2^(2*kRawBits - 2): the wide product never overflows.
+    return fromRaw(narrow(roundShift(Wide(a.raw_) * Wide(b.raw_))));
+  }
+  friend constexpr Fixed operator/(Fixed a, Fixed b) noexcept {
+    if (b.raw_ == 0) {
+      detail::raiseFixedFault(kFixedFaultDivideByZero);
+      return a.raw_ < 0 ? min() : max();
+    }
+    return fromRaw(narrow(divRound(Wide(a.raw_) * Wide(kOneRaw), Wide(b.raw_))));
+  }
+
+  constexpr Fixed& operator+=(Fixed b) noexcept { return *this = *this + b; }
+  constexpr Fixed& operator-=(Fixed b) noexcept { return *this = *this - b; }
+  constexpr Fixed& operator*=(Fixed b) noexcept { return *this = *this * b; }
+  constexpr Fixed& operator/=(Fixed b) noexcept { return *this = *this / b; }
+
+  friend constexpr bool operator==(Fixed a, Fixed b) noexcept = default;
+  friend constexpr auto operator<=>(Fixed a, Fixed b) noexcept = default;
+
+  /// round(a * b / c) with the full-width product (one rounding instead of two).
+  static constexpr Fixed mulDiv(Fixed a, Fixed b, Fixed c) noexcept {
+    if (c.raw_ == 0) {
+      detail::raiseFixedFault(kFixedFaultDivideByZero);
+      return max();
+    }
+    return fromRaw(narrow(divRound(Wide(a.raw_) * Wide(b.raw_), Wide(c.raw_))));
+  }
+
+  template <class I>
+  static constexpr Raw fromInteger(I value) noexcept {
+    constexpr Raw kMaxInt = std::numeric_limits<Raw>::max() >> Frac;
+    constexpr Raw kMinInt = std::numeric_limits<Raw>::min() >> Frac;
+    if constexpr (std::is_signed_v<I>) {
+      if (value > I(0) ? uint64_t(value) > uint64_t(kMaxInt) : int64_t(value) < int64_t(kMinInt)) {
+        detail::raiseFixedFault(kFixedFaultOverflow);
+        return value > I(0) ? std::numeric_limits<Raw>::max() : std::numeric_limits<Raw>::min();
+      }
+    } else if (uint64_t(value) > uint64_t(kMaxInt)) {
+      detail::raiseFixedFault(kFixedFaultOverflow);
+      return std::numeric_limits<Raw>::max();
+    }
+    return static_cast<Raw>(Wide(value) * Wide(kOneRaw));
+  }
+  /// Narrows a wide value to Raw, raising an overflow fault when it does not fit.
+  static constexpr Raw narrow(Wide w) noexcept {
+    if (w > Wide(std::numeric_limits<Raw>::max()) || w < Wide(std::numeric_limits<Raw>::min()))
+      detail::raiseFixedFault(kFixedFaultOverflow);
+    return static_cast<Raw>(w);  // modular since C++20: defined
+  }
+  /// p / 2^Frac rounded to nearest, ties away from zero. Requires |p| < 2^(2*kRawBits-1).
+  static constexpr Wide roundShift(Wide p) noexcept {
+    const Wide sign = p >> (2 * kRawBits - 1);  // 0 or -1 (arithmetic shift, defined in C++20)
+    Wide mag = (p ^ sign) - sign;
+    mag = (mag + (Wide(1) << (Frac - 1))) >> Frac;
+    return (mag ^ sign) - sign;
+  }
+  /// n / d rounded to nearest, ties away from zero. d != 0; |n|, |d| < 2^(2*kRawBits-1).
+  static constexpr Wide divRound(Wide n, Wide d) noexcept {
+    Wide q = n / d;
+    const Wide r = n % d;
+    const Wide absR = r < 0 ? -r : r;
+    const Wide absD = d < 0 ? -d : d;
+    if (absR >= absD - absR) q += ((n < 0) != (d < 0)) ? -1 : 1;
+    return q;
+  }
+
+ private:
+  Raw raw_ = 0;
+};
+
+using Fx32 = Fixed<int64_t, __int128, 32>;
+using Fx16 = Fixed<int32_t, int64_t, 16>;
+
+template <class Raw, class Wide, int Frac>
+Fixed<Raw, Wide, Frac> Fixed<Raw, Wide, Frac>::fromDouble(double v) noexcept {
+  const long double scaled = static_cast<long double>(v) * static_cast<long double>(kOneRaw);
+  const long double lim = static_cast<long double>(std::numeric_limits<Raw>::max());
+  if (!(scaled < lim && scaled > -lim)) {
+    detail::raiseFixedFault(kFixedFaultOverflow);
+    return v < 0 ? min() : max();
+  }
+  const long double r = scaled < 0 ? -(-scaled + 0.5L) : scaled + 0.5L;
+  return fromRaw(static_cast<Raw>(r));  // truncation toward zero after the half: away from zero
+}
+
+// ---- free functions (found by argument-dependent lookup, also by Eigen) -------------------
+
+template <class R, class W, int F>
+constexpr Fixed<R, W, F> abs(Fixed<R, W, F> a) noexcept {
+  return a.raw() < 0 ? -a : a;
+}
+
+/// Square root rounded to nearest; a negative argument raises a domain fault and returns 0.
+template <class R, class W, int F>
+inline Fixed<R, W, F> sqrt(Fixed<R, W, F> a) noexcept {
+  using Fx = Fixed<R, W, F>;
+  if (a.raw() < 0) {
+    detail::raiseFixedFault(kFixedFaultDomain);
+    return Fx();
+  }
+  // sqrt(raw / 2^F) * 2^F = sqrt(raw * 2^F): the radicand is exact in 128 bits.
+  const unsigned __int128 n = static_cast<unsigned __int128>(a.raw()) << F;
+  return Fx::fromRaw(static_cast<R>(isqrtNearest(n)));  // < 2^(bits/2 + F/2): always fits
+}
+
+/// |(x, y, z)| rounded to nearest from the exact sum of squares (one rounding only). An axis
+/// vector (0, y, 0) has length exactly |y|.
+template <class R, class W, int F>
+inline Fixed<R, W, F> length3(Fixed<R, W, F> x, Fixed<R, W, F> y, Fixed<R, W, F> z) noexcept {
+  using Fx = Fixed<R, W, F>;
+  using U = unsigned __int128;
+  auto sq = [](R v) { const U m = v < 0 ? U(0) - U(v) : U(v); return m * m; };
+  // Each square is < 2^(2*bits-2), so the sum of three fits in 2*bits unsigned bits.
+  const uint64_t r = isqrtNearest(sq(x.raw()) + sq(y.raw()) + sq(z.raw()));
+  if (r > uint64_t(std::numeric_limits<R>::max())) detail::raiseFixedFault(kFixedFaultOverflow);
+  return Fx::fromRaw(static_cast<R>(r));
+}
+
+template <class R, class W, int F>
+constexpr Fixed<R, W, F> min(Fixed<R, W, F> a, Fixed<R, W, F> b) noexcept {
+  return b < a ? b : a;
+}
+template <class R, class W, int F>
+constexpr Fixed<R, W, F> max(Fixed<R, W, F> a, Fixed<R, W, F> b) noexcept {
+  return a < b ? b : a;
+}
+
+}  // namespace sg

@@ -1,0 +1,259 @@
+#include "sim/math/rational.h"
+
+#include <cctype>
+#include <cmath>
+
+namespace sg {
+namespace {
+using I128 = __int128;
+using U128 = unsigned __int128;
+
+I128 gcd(I128 a, I128 b) {
+  if (a < 0) a = -a;
+  if (b < 0) b = -b;
+  while (b != 0) {
+    const I128 t = a % b;
+    a = b;
+    b = t;
+  }
+  return a;
+}
+
+bool mulChecked(I128 a, I128 b, I128* out) { return !__builtin_mul_overflow(a, b, out); }
+
+std::string toDecimalString(I128 v) {
+  if (v == 0) return "0";
+  const bool neg = v < 0;
+  U128 m = neg ? U128(0) - U128(v) : U128(v);
+  std::string s;
+  while (m != 0) {
+    s.insert(s.begin(), char('0' + int(m % 10)));
+    m /= 10;
+  }
+  return neg ? "-" + s : s;
+}
+
+// Parses a plain decimal number token: -?digits[.digits][e[+-]digits].
+std::optional<Rational> parseDecimal(std::string_view t, std::string* error) {
+  constexpr int kMaxDigits = 30;  // keeps num and 10^k well inside 128 bits
+  size_t i = 0;
+  bool neg = false;
+  if (i < t.size() && (t[i] == '-' || t[i] == '+')) neg = t[i++] == '-';
+  I128 mant = 0;
+  int digits = 0, scale = 0;  // value = mant * 10^(-scale)
+  bool any = false, dot = false;
+  for (; i < t.size(); ++i) {
+    const char c = t[i];
+    if (c == '.' && !dot) {
+      dot = true;
+      continue;
+    }
+    if (!std::isdigit(static_cast<unsigned char>(c))) break;
+    any = true;
+    if (mant == 0 && c == '0') {
+      if (dot) ++scale;  // leading zeros after the point only shift the scale
+      continue;
+    }
+    if (++digits > kMaxDigits) {
+      if (error) *error = "a number with at most 30 significant digits";
+      return std::nullopt;
+    }
+    mant = mant * 10 + (c - '0');
+    if (dot) ++scale;
+  }
+  if (!any) {
+    if (error) *error = "a number";
+    return std::nullopt;
+  }
+  int exp10 = 0;
+  if (i < t.size() && (t[i] == 'e' || t[i] == 'E')) {
+    ++i;
+    bool eneg = false;
+    if (i < t.size() && (t[i] == '-' || t[i] == '+')) eneg = t[i++] == '-';
+    bool edig = false;
+    for (; i < t.size() && std::isdigit(static_cast<unsigned char>(t[i])); ++i) {
+      edig = true;
+      if (exp10 < 10000) exp10 = exp10 * 10 + (t[i] - '0');
+    }
+    if (!edig) {
+      if (error) *error = "a number (exponent digits after 'e')";
+      return std::nullopt;
+    }
+    if (eneg) exp10 = -exp10;
+  }
+  if (i != t.size()) {
+    if (error) *error = "a number";
+    return std::nullopt;
+  }
+  if (mant == 0) return Rational{0, 1};
+  const int e = exp10 - scale;  // value = mant * 10^e
+  if (e > 36 - digits || e < -36) {
+    if (error) *error = "a number between 1e-36 and 1e36 in magnitude";
+    return std::nullopt;
+  }
+  I128 p = 1;
+  for (int k = 0; k < (e < 0 ? -e : e); ++k) p *= 10;
+  const I128 n = neg ? -mant : mant;
+  auto r = e >= 0 ? Rational::make(n * p, 1) : Rational::make(n, p);
+  if (!r && error) *error = "a number of representable size";
+  return r;
+}
+}  // namespace
+
+std::optional<Rational> Rational::make(I128 num, I128 den) {
+  if (den == 0) return std::nullopt;
+  if (den < 0) {
+    num = -num;
+    den = -den;
+  }
+  const I128 g = gcd(num, den);
+  if (g > 1) {
+    num /= g;
+    den /= g;
+  }
+  return Rational{num, den};
+}
+
+std::optional<Rational> Rational::parse(std::string_view text, std::string* error) {
+  const size_t slash = text.find('/');
+  if (slash == std::string_view::npos) return parseDecimal(text, error);
+  auto a = parseDecimal(text.substr(0, slash), error);
+  auto b = parseDecimal(text.substr(slash + 1), error);
+  if (!a || !b) return std::nullopt;
+  if (b->isZero()) {
+    if (error) *error = "a fraction with a non-zero denominator";
+    return std::nullopt;
+  }
+  auto r = sg::div(*a, *b);
+  if (!r && error) *error = "a fraction of representable size";
+  return r;
+}
+
+std::optional<Rational> add(const Rational& a, const Rational& b) {
+  I128 x, y, d, n;
+  if (!mulChecked(a.num, b.den, &x) || !mulChecked(b.num, a.den, &y) ||
+      !mulChecked(a.den, b.den, &d) || __builtin_add_overflow(x, y, &n))
+    return std::nullopt;
+  return Rational::make(n, d);
+}
+std::optional<Rational> sub(const Rational& a, const Rational& b) {
+  return add(a, Rational{-b.num, b.den});
+}
+std::optional<Rational> mul(const Rational& a, const Rational& b) {
+  // Cross-reduce first to keep intermediates small.
+  const I128 g1 = gcd(a.num, b.den), g2 = gcd(b.num, a.den);
+  const I128 an = g1 ? a.num / g1 : a.num, bd = g1 ? b.den / g1 : b.den;
+  const I128 bn = g2 ? b.num / g2 : b.num, ad = g2 ? a.den / g2 : a.den;
+  I128 n, d;
+  if (!mulChecked(an, bn, &n) || !mulChecked(ad, bd, &d)) return std::nullopt;
+  return Rational::make(n, d);
+}
+std::optional<Rational> div(const Rational& a, const Rational& b) {
+  if (b.num == 0) return std::nullopt;
+  return mul(a, Rational{b.den * (b.num < 0 ? -1 : 1), b.num < 0 ? -b.num : b.num});
+}
+int compare(const Rational& a, const Rational& b) {
+  auto d = sub(a, b);
+  if (d) return d->num < 0 ? -1 : (d->num > 0 ? 1 : 0);
+  // Too large to subtract exactly: compare via long double (only reached for absurd values).
+  const long double x = (long double)a.num / (long double)a.den;
+  const long double y = (long double)b.num / (long double)b.den;
+  return x < y ? -1 : (x > y ? 1 : 0);
+}
+
+double Rational::toDouble() const {
+  constexpr I128 k2p53 = I128(1) << 53;
+  if (num > -k2p53 && num < k2p53 && den < k2p53) return double(num) / double(den);
+  return double((long double)num / (long double)den);
+}
+
+std::optional<I128> Rational::toScaledInteger(int fracBits) const {
+  // Exact long division: integer part, then fracBits + 1 quotient bits and a sticky remainder.
+  const bool neg = num < 0;
+  const U128 n = neg ? U128(0) - U128(num) : U128(num);
+  const U128 d = U128(den);
+  U128 q = n / d, r = n % d;
+  if (q >> (126 - fracBits) != 0) return std::nullopt;
+  for (int k = 0; k < fracBits; ++k) {
+    r <<= 1;  // r < d < 2^127: no overflow
+    q <<= 1;
+    if (r >= d) {
+      r -= d;
+      q |= 1;
+    }
+  }
+  // Round half away from zero on the magnitude: compare 2r with d.
+  if (r >= d - r) q += 1;
+  if (q >> 126 != 0) return std::nullopt;
+  return neg ? -I128(q) : I128(q);
+}
+
+std::optional<int64_t> Rational::roundToInt64() const {
+  auto v = toScaledInteger(0);
+  if (!v || *v > I128(INT64_MAX) || *v < I128(INT64_MIN)) return std::nullopt;
+  return int64_t(*v);
+}
+
+std::string Rational::toString() const {
+  return den == 1 ? toDecimalString(num) : toDecimalString(num) + "/" + toDecimalString(den);
+}
+
+// ---- deterministic pow --------------------------------------------------------------------
+namespace {
+constexpr int kQ = 62;
+constexpr I128 kOne = I128(1) << kQ;
+
+I128 qmul(I128 a, I128 b) {  // |a|,|b| < 2^64 keeps the product inside 128 bits
+  const I128 p = a * b;
+  return p >= 0 ? (p + (I128(1) << (kQ - 1))) >> kQ : -((-p + (I128(1) << (kQ - 1))) >> kQ);
+}
+I128 qdiv(I128 a, I128 b) { return (a << kQ) / b; }  // a < 2^64 in use: no overflow
+
+// ln(m) for m in [1/2, 1] via 2*atanh((m-1)/(m+1)); |y| <= 1/3, so 40 terms exceed 2^-62.
+I128 lnReduced(I128 m) {
+  const I128 y = qdiv(m - kOne, m + kOne);
+  const I128 y2 = qmul(y, y);
+  I128 term = y, sum = 0;
+  for (int k = 1; k < 120 && term != 0; k += 2) {
+    sum += term / k;
+    term = qmul(term, y2);
+  }
+  return 2 * sum;
+}
+I128 ln2() { return -lnReduced(kOne / 2); }
+
+// exp(x) for x <= 0 in Q62: x = -k ln2 + r with r in (-ln2, 0], Taylor series for exp(r).
+I128 expNonPositive(I128 x) {
+  const I128 l2 = ln2();
+  I128 k = (-x) / l2;
+  const I128 r = x + k * l2;  // in (-ln2, 0]
+  I128 term = kOne, sum = kOne;
+  for (int n = 1; n < 60 && term != 0; ++n) {
+    term = qmul(term, r) / n;
+    sum += term;
+  }
+  if (k >= 120) return 0;
+  return sum >> int(k);
+}
+}  // namespace
+
+Rational deterministicPow(const Rational& base, const Rational& exponent) {
+  // Preconditions are checked by the scenario loader: 0 < base <= 1, exponent >= 0.
+  if (base.num == base.den || exponent.num == 0) return Rational{1, 1};
+  // base = m * 2^-e with m in [1/2, 1): ln(base) = ln(m) - e ln2.
+  I128 q = (base.num << kQ) / base.den;  // base in Q62 (base <= 1, so no overflow)
+  if (q <= 0) return Rational{0, 1};
+  int e = 0;
+  while (q < kOne / 2) {
+    q <<= 1;
+    ++e;
+  }
+  const I128 lnBase = lnReduced(q) - I128(e) * ln2();  // <= 0, |lnBase| < 2^69
+  // x = exponent * ln(base), computed as (lnBase * num) / den with a 128-bit guard.
+  I128 prod;
+  if (__builtin_mul_overflow(lnBase, exponent.num, &prod)) return Rational{0, 1};
+  const I128 x = prod / exponent.den;
+  const I128 result = expNonPositive(x);
+  return *Rational::make(result, kOne);
+}
+}  // namespace sg

@@ -1,0 +1,40 @@
+// Particle state as structure-of-arrays. One particle per k x k patches: particle (a, b) is the
+// control point at patch (k*a, k*b) of the field, anchored at that patch's root; the particle
+// lattice covers the field with one extra column/row where needed so that every patch
+// interpolates between particles (no border special cases).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace sg {
+
+struct ParticleGrid {
+  int k = 1;            ///< patches per particle along each axis
+  int64_t countX = 0;   ///< particles per row (along x)
+  int64_t countZ = 0;   ///< particle rows (along z)
+  int64_t size() const { return countX * countZ; }
+  /// Particles per axis covering n patches: ceil((n - 1) / k) + 1.
+  static int64_t coverCount(int64_t patches, int k) { return (patches - 1 + k - 1) / k + 1; }
+};
+
+template <class S>
+struct ParticleArrays {
+  std::vector<S> px, py, pz;              ///< position (m)
+  std::vector<S> vx, vy, vz;              ///< velocity (m/s)
+  std::vector<S> anchorX, anchorY, anchorZ;  ///< rod anchor = tuft root on the ground (m)
+  void resize(size_t n) {
+    for (auto* v : {&px, &py, &pz, &vx, &vy, &vz, &anchorX, &anchorY, &anchorZ}) v->assign(n, S(0));
+  }
+};
+
+/// Per-scenario particle constants, rounded once into the scalar.
+template <class S>
+struct ParticleConstants {
+  S dt{};              ///< s
+  S invDt{};           ///< 1/s
+  S dampingPerTick{};  ///< damping^dt, from deterministicPow
+  S rodLength{};       ///< L (m)
+};
+
+}  // namespace sg

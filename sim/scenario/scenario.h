@@ -1,0 +1,121 @@
+// A scenario: everything that defines a world, scalar-independent and exact. Numbers are kept
+// as exact fractions (Rational) so every scalar rounds the scenario's decimal text exactly once.
+// The JSON format is documented in docs/scenario-format.md.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "sim/math/rational.h"
+#include "sim/math/scalar.h"
+#include "sim/terrain/heightmap.h"
+
+namespace sg {
+
+using Rational3 = std::array<Rational, 3>;
+
+/// How the rod constraint treats velocity after projecting the position back to length L.
+enum class ConstraintMode : uint8_t {
+  Thesis,  ///< position projected, velocity untouched (Cyclone, as in the thesis)
+  Pbd,     ///< position-based dynamics: velocity recomputed from the corrected position
+};
+/// Which row a gust reaches first.
+enum class WindTravel : uint8_t {
+  Direction,  ///< a gust enters from the side it blows from (+z gusts: first row first)
+  Forward,    ///< every gust travels +z (what the thesis code did: its loop order had no effect)
+};
+
+struct WindGust {
+  Rational3 force;    ///< N (mass 1: m/s^2)
+  Rational duration;  ///< s
+};
+
+struct Scenario {
+  std::string name = "thesis-meadow";
+  uint64_t seed = 1;
+  ScalarKind scalar = ScalarKind::Fx32;
+  Rational timeStep{1, 60};  ///< s per tick
+
+  struct Field {
+    int64_t patchesX = 151, patchesZ = 151;
+    Rational spacing{1, 4};      ///< m between patch centres
+    Rational jitter{3, 10};      ///< max |offset| as a fraction of spacing
+    Rational centerX{0, 1}, centerZ{0, 1};  ///< m, world position of the field centre
+    Rational scaleY{1, 1};       ///< m, tuft quad height (mScaleY)
+    Rational scaleXZ{1, 2};      ///< m, tuft quad half width (mScaleXZ)
+    int atlasVariants = 4;
+  } field;
+
+  struct Particles {
+    int interpolation = 1;           ///< k: one particle per k x k patches
+    Rational constraintLength{1, 1}; ///< m, rod length L
+    Rational3 initialVelocity{Rational{1, 5}, Rational{1, 5}, Rational{1, 5}};  ///< m/s
+    Rational3 acceleration{Rational{0, 1}, Rational{1, 1}, Rational{0, 1}};     ///< m/s^2
+    Rational mass{1, 1};             ///< kg
+    Rational damping{97, 100};       ///< velocity factor per second (v *= damping^dt)
+    ConstraintMode constraintMode = ConstraintMode::Thesis;
+    /// Tilt brightness thresholds: level n when the tip sinks more than tiltDrop[n-1] below L.
+    std::array<Rational, 3> tiltDrop{Rational{1, 5}, Rational{3, 10}, Rational{2, 5}};
+  } particles;
+
+  struct Wind {
+    Rational travelSpeed{15, 2};  ///< m/s at which a gust front crosses the rows
+    WindTravel travel = WindTravel::Direction;
+    std::vector<WindGust> schedule = {
+        {{Rational{0, 1}, Rational{1, 1}, Rational{9, 10}}, Rational{5, 1}},
+        {{Rational{0, 1}, Rational{0, 1}, Rational{0, 1}}, Rational{6, 1}},
+        {{Rational{0, 1}, Rational{1, 1}, Rational{-9, 10}}, Rational{4, 1}},
+        {{Rational{0, 1}, Rational{0, 1}, Rational{0, 1}}, Rational{6, 1}},
+    };
+  } wind;
+
+  struct Terrain {
+    bool flat = true;
+    Rational flatHeight{0, 1};  ///< m
+    std::string heightmapPath;  ///< as written in the scenario (relative to the scenario file)
+    Heightmap heightmap;
+    Rational cellSize{1, 1};    ///< m between heightmap samples
+    Rational maxHeight{5, 1};   ///< m at sample value 255
+    Rational centerX{0, 1}, centerZ{0, 1};  ///< m, world position of the heightmap centre
+  } terrain;
+
+  std::string sourceName = "<built-in>";  ///< file name for error messages
+  std::string text;                       ///< the JSON text it was parsed from
+};
+
+/// A bad scenario: names the file, the JSON path and what was expected.
+class ScenarioError : public std::runtime_error {
+ public:
+  ScenarioError(const std::string& file, const std::string& path, const std::string& expected);
+  const std::string& file() const { return file_; }
+  const std::string& path() const { return path_; }
+ private:
+  std::string file_, path_;
+};
+
+/// Reads the bytes of a file named in a scenario (the heightmap), relative to the scenario.
+/// Returns false with *error set ("file 'x.png' not found") when it cannot.
+using ScenarioFileReader =
+    std::function<bool(const std::string& path, std::vector<uint8_t>* bytes, std::string* error)>;
+
+/// Parses and validates a scenario. Throws ScenarioError. Unknown keys are errors; missing keys
+/// take the thesis defaults above.
+Scenario parseScenario(const std::string& text, const std::string& sourceName,
+                       const ScenarioFileReader& readFile);
+
+/// The thesis meadow, embedded (identical to scenarios/thesis-meadow.json).
+const std::string& defaultScenarioText();
+
+/// Checks that the scenario fits the chosen scalar (coordinates, resolution) and a memory
+/// budget. Throws ScenarioError naming the offending JSON path.
+void validateForScalar(const Scenario& scenario, ScalarKind scalar, uint64_t memoryLimitBytes);
+
+/// Bytes of world state per patch and per particle for a scalar (used by the memory check).
+uint64_t estimateWorldBytes(const Scenario& scenario, ScalarKind scalar);
+
+}  // namespace sg

@@ -1,0 +1,392 @@
+// Scenario JSON -> Scenario, with one-line errors that name the file, the JSON path and what
+// was expected. Numbers are read from their raw text (collected by a SAX pass) so that the
+// decimal -> fixed-point conversion is exact.
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "sim/scenario/scenario.h"
+
+namespace sg {
+namespace {
+using json = nlohmann::json;
+
+// Records the raw text of every non-integer number by JSON path, and rejects duplicate keys.
+class RawNumberCollector : public nlohmann::json_sax<json> {
+ public:
+  std::map<std::string, std::string> raw;
+  std::string duplicatePath;  // first duplicate key seen, as a JSON path
+
+  bool null() override { return after(); }
+  bool boolean(bool) override { return after(); }
+  bool number_integer(number_integer_t) override { return after(); }
+  bool number_unsigned(number_unsigned_t) override { return after(); }
+  bool number_float(number_float_t, const string_t& s) override {
+    raw[path()] = s;
+    return after();
+  }
+  bool string(string_t&) override { return after(); }
+  bool binary(binary_t&) override { return after(); }
+  bool start_object(std::size_t) override {
+    frames_.push_back(Frame{false, {}, 0, {}});
+    return true;
+  }
+  bool key(string_t& k) override {
+    Frame& f = frames_.back();
+    if (!f.keys.insert(k).second && duplicatePath.empty()) {
+      f.key = k;
+      duplicatePath = path();
+    }
+    f.key = k;
+    return true;
+  }
+  bool end_object() override {
+    frames_.pop_back();
+    return after();
+  }
+  bool start_array(std::size_t) override {
+    frames_.push_back(Frame{true, {}, 0, {}});
+    return true;
+  }
+  bool end_array() override {
+    frames_.pop_back();
+    return after();
+  }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override {
+    return false;  // the DOM parse reports syntax errors with their position
+  }
+
+ private:
+  struct Frame {
+    bool array;
+    std::string key;
+    int64_t index;
+    std::set<std::string> keys;
+  };
+  std::vector<Frame> frames_;
+  std::string path() const {
+    std::string p = "$";
+    for (const Frame& f : frames_) p += f.array ? "[" + std::to_string(f.index) + "]" : "." + f.key;
+    return p;
+  }
+  bool after() {
+    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+    return true;
+  }
+};
+
+const char* typeName(const json& j) {
+  switch (j.type()) {
+    case json::value_t::null: return "null";
+    case json::value_t::boolean: return "a boolean";
+    case json::value_t::string: return "a string";
+    case json::value_t::array: return "an array";
+    case json::value_t::object: return "an object";
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned:
+    case json::value_t::number_float: return "a number";
+    default: return "a value";
+  }
+}
+
+std::string show(const json& j) {
+  std::string s = j.dump();
+  if (s.size() > 40) s = s.substr(0, 37) + "...";
+  return s;
+}
+
+class Reader {
+ public:
+  Reader(std::string file, const std::map<std::string, std::string>& raw) : file_(std::move(file)), raw_(raw) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& expected) const {
+    throw ScenarioError(file_, path, expected);
+  }
+  [[noreturn]] void failGot(const std::string& path, const std::string& expected, const json& got) const {
+    fail(path, expected + ", got " + show(got));
+  }
+
+  /// Checks that j is an object whose keys are all in `allowed`.
+  void object(const json& j, const std::string& path, std::initializer_list<const char*> allowed) const {
+    if (!j.is_object()) fail(path, std::string("an object, got ") + typeName(j));
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      bool ok = false;
+      for (const char* a : allowed) ok = ok || it.key() == a;
+      if (!ok) {
+        std::string list;
+        for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
+        fail(path + "." + it.key(), "one of the keys {" + list + "}; unknown key '" + it.key() + "'");
+      }
+    }
+  }
+
+  Rational number(const json& j, const std::string& path) const {
+    std::string text;
+    if (j.is_number_integer()) {
+      text = j.dump();
+    } else if (j.is_number_float()) {
+      auto it = raw_.find(path);
+      text = it != raw_.end() ? it->second : j.dump();
+    } else if (j.is_string()) {
+      text = j.get<std::string>();  // fractions such as "1/60"
+    } else {
+      fail(path, std::string("a number, got ") + typeName(j));
+    }
+    std::string why;
+    auto r = Rational::parse(text, &why);
+    if (!r) fail(path, why + ", got " + show(j));
+    return *r;
+  }
+  Rational positive(const json& j, const std::string& path) const {
+    Rational r = number(j, path);
+    if (r.num <= 0) failGot(path, "a positive number", j);
+    return r;
+  }
+  Rational nonNegative(const json& j, const std::string& path) const {
+    Rational r = number(j, path);
+    if (r.num < 0) failGot(path, "a number >= 0", j);
+    return r;
+  }
+  int64_t integer(const json& j, const std::string& path, int64_t lo, int64_t hi) const {
+    const std::string expected = "an integer from " + std::to_string(lo) + " to " + std::to_string(hi);
+    if (!j.is_number_integer()) failGot(path, expected, j);
+    if (j.is_number_unsigned()) {
+      if (j.get<uint64_t>() > uint64_t(hi) || int64_t(j.get<uint64_t>()) < lo) failGot(path, expected, j);
+      return int64_t(j.get<uint64_t>());
+    }
+    const int64_t v = j.get<int64_t>();
+    if (v < lo || v > hi) failGot(path, expected, j);
+    return v;
+  }
+  template <size_t N>
+  std::array<Rational, N> vector(const json& j, const std::string& path) const {
+    if (!j.is_array() || j.size() != N) failGot(path, "an array of " + std::to_string(N) + " numbers", j);
+    std::array<Rational, N> out;
+    for (size_t i = 0; i < N; ++i) out[i] = number(j[i], path + "[" + std::to_string(i) + "]");
+    return out;
+  }
+  std::string string(const json& j, const std::string& path) const {
+    if (!j.is_string()) fail(path, std::string("a string, got ") + typeName(j));
+    return j.get<std::string>();
+  }
+  template <class E>
+  E choice(const json& j, const std::string& path, std::initializer_list<std::pair<const char*, E>> options) const {
+    std::string list;
+    for (auto& o : options) list += std::string(list.empty() ? "" : ", ") + "\"" + o.first + "\"";
+    if (j.is_string())
+      for (auto& o : options)
+        if (j.get<std::string>() == o.first) return o.second;
+    failGot(path, "one of " + list, j);
+  }
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+  const std::map<std::string, std::string>& raw_;
+};
+
+void parseField(const Reader& r, const json& j, Scenario::Field& f) {
+  const std::string p = "$.field";
+  r.object(j, p, {"patchesX", "patchesZ", "spacing", "jitter", "center", "scaleY", "scaleXZ", "atlasVariants"});
+  if (j.contains("patchesX")) f.patchesX = r.integer(j["patchesX"], p + ".patchesX", 1, int64_t(1) << 20);
+  if (j.contains("patchesZ")) f.patchesZ = r.integer(j["patchesZ"], p + ".patchesZ", 1, int64_t(1) << 20);
+  if (j.contains("spacing")) f.spacing = r.positive(j["spacing"], p + ".spacing");
+  if (j.contains("jitter")) {
+    f.jitter = r.nonNegative(j["jitter"], p + ".jitter");
+    if (compare(f.jitter, Rational{1, 2}) > 0) r.failGot(p + ".jitter", "a fraction of the spacing from 0 to 0.5", j["jitter"]);
+  }
+  if (j.contains("center")) {
+    auto c = r.vector<2>(j["center"], p + ".center");
+    f.centerX = c[0];
+    f.centerZ = c[1];
+  }
+  if (j.contains("scaleY")) f.scaleY = r.positive(j["scaleY"], p + ".scaleY");
+  if (j.contains("scaleXZ")) f.scaleXZ = r.positive(j["scaleXZ"], p + ".scaleXZ");
+  if (j.contains("atlasVariants")) f.atlasVariants = int(r.integer(j["atlasVariants"], p + ".atlasVariants", 1, 16));
+}
+
+void parseParticles(const Reader& r, const json& j, Scenario::Particles& s) {
+  const std::string p = "$.particles";
+  r.object(j, p, {"interpolation", "constraintLength", "initialVelocity", "acceleration", "mass", "damping",
+                  "constraintMode", "tiltDrop"});
+  if (j.contains("interpolation")) s.interpolation = int(r.integer(j["interpolation"], p + ".interpolation", 1, 4));
+  if (j.contains("constraintLength")) s.constraintLength = r.positive(j["constraintLength"], p + ".constraintLength");
+  if (j.contains("initialVelocity")) s.initialVelocity = r.vector<3>(j["initialVelocity"], p + ".initialVelocity");
+  if (j.contains("acceleration")) s.acceleration = r.vector<3>(j["acceleration"], p + ".acceleration");
+  if (j.contains("mass")) s.mass = r.positive(j["mass"], p + ".mass");
+  if (j.contains("damping")) {
+    s.damping = r.positive(j["damping"], p + ".damping");
+    if (compare(s.damping, Rational{1, 1}) > 0) r.failGot(p + ".damping", "a damping factor in (0, 1]", j["damping"]);
+  }
+  if (j.contains("constraintMode"))
+    s.constraintMode = r.choice<ConstraintMode>(j["constraintMode"], p + ".constraintMode",
+                                                {{"thesis", ConstraintMode::Thesis}, {"pbd", ConstraintMode::Pbd}});
+  if (j.contains("tiltDrop")) {
+    s.tiltDrop = r.vector<3>(j["tiltDrop"], p + ".tiltDrop");
+    for (int i = 0; i < 3; ++i) {
+      const std::string q = p + ".tiltDrop[" + std::to_string(i) + "]";
+      if (s.tiltDrop[i].num < 0) r.failGot(q, "a number >= 0", j["tiltDrop"][i]);
+      if (i > 0 && compare(s.tiltDrop[i], s.tiltDrop[i - 1]) <= 0)
+        r.failGot(q, "thresholds in increasing order", j["tiltDrop"][i]);
+    }
+  }
+}
+
+void parseWind(const Reader& r, const json& j, Scenario::Wind& w) {
+  const std::string p = "$.wind";
+  r.object(j, p, {"travelSpeed", "travel", "schedule"});
+  if (j.contains("travelSpeed")) w.travelSpeed = r.positive(j["travelSpeed"], p + ".travelSpeed");
+  if (j.contains("travel"))
+    w.travel = r.choice<WindTravel>(j["travel"], p + ".travel",
+                                    {{"direction", WindTravel::Direction}, {"forward", WindTravel::Forward}});
+  if (j.contains("schedule")) {
+    const json& s = j["schedule"];
+    if (!s.is_array() || s.size() > 1024) r.failGot(p + ".schedule", "an array of at most 1024 gusts", s);
+    w.schedule.clear();
+    for (size_t i = 0; i < s.size(); ++i) {
+      const std::string q = p + ".schedule[" + std::to_string(i) + "]";
+      r.object(s[i], q, {"force", "duration"});
+      if (!s[i].contains("force")) r.fail(q + ".force", "a force [x, y, z] (missing)");
+      if (!s[i].contains("duration")) r.fail(q + ".duration", "a duration in seconds (missing)");
+      w.schedule.push_back({r.vector<3>(s[i]["force"], q + ".force"), r.positive(s[i]["duration"], q + ".duration")});
+    }
+  }
+}
+
+void parseTerrain(const Reader& r, const json& j, Scenario::Terrain& t, const ScenarioFileReader& readFile) {
+  const std::string p = "$.terrain";
+  r.object(j, p, {"type", "height", "file", "cellSize", "maxHeight", "center"});
+  const bool heightmap = j.contains("type") &&
+      r.choice<bool>(j["type"], p + ".type", {{"flat", false}, {"heightmap", true}});
+  t.flat = !heightmap;
+  if (!heightmap) {
+    for (const char* k : {"file", "cellSize", "maxHeight", "center"})
+      if (j.contains(k)) r.fail(p + "." + k, "no '" + std::string(k) + "' for a flat terrain (set \"type\": \"heightmap\")");
+    if (j.contains("height")) t.flatHeight = r.number(j["height"], p + ".height");
+    return;
+  }
+  if (j.contains("height")) r.fail(p + ".height", "no 'height' for a heightmap terrain (use maxHeight)");
+  if (!j.contains("file")) r.fail(p + ".file", "the heightmap PNG file name (missing)");
+  t.heightmapPath = r.string(j["file"], p + ".file");
+  if (j.contains("cellSize")) t.cellSize = r.positive(j["cellSize"], p + ".cellSize");
+  if (j.contains("maxHeight")) t.maxHeight = r.nonNegative(j["maxHeight"], p + ".maxHeight");
+  if (j.contains("center")) {
+    auto c = r.vector<2>(j["center"], p + ".center");
+    t.centerX = c[0];
+    t.centerZ = c[1];
+  }
+  std::vector<uint8_t> bytes;
+  std::string why;
+  if (!readFile || !readFile(t.heightmapPath, &bytes, &why)) r.fail(p + ".file", why.empty() ? "a readable file" : why);
+  if (!decodeHeightmapPng(bytes, &t.heightmap, &why))
+    r.fail(p + ".file", "'" + t.heightmapPath + "' to be " + why);
+}
+
+std::string lineColumn(const std::string& text, size_t byte) {
+  size_t line = 1, col = 1;
+  for (size_t i = 0; i < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(col);
+}
+}  // namespace
+
+ScenarioError::ScenarioError(const std::string& file, const std::string& path, const std::string& expected)
+    : std::runtime_error(file + ": " + path + ": expected " + expected), file_(file), path_(path) {}
+
+Scenario parseScenario(const std::string& text, const std::string& sourceName, const ScenarioFileReader& readFile) {
+  json root;
+  try {
+    root = json::parse(text);
+  } catch (const json::parse_error& e) {
+    // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: ..."
+    std::string what = e.what();
+    const size_t colon = what.find(": ", what.find("parse error"));
+    std::string detail = colon == std::string::npos ? what : what.substr(colon + 2);
+    throw ScenarioError(sourceName, "byte " + std::to_string(e.byte) + " (" + lineColumn(text, e.byte ? e.byte - 1 : 0) + ")",
+                        "valid JSON (" + detail + ")");
+  }
+  RawNumberCollector collector;
+  json::sax_parse(text, &collector);
+  if (!collector.duplicatePath.empty())
+    throw ScenarioError(sourceName, collector.duplicatePath, "each key once (this key appears twice)");
+
+  Reader r(sourceName, collector.raw);
+  Scenario s;
+  s.sourceName = sourceName;
+  s.text = text;
+  r.object(root, "$", {"format", "name", "description", "seed", "scalar", "timeStep", "field", "particles", "wind", "terrain"});
+  if (root.contains("format") && root["format"] != "simgrass-scenario/1")
+    r.failGot("$.format", "\"simgrass-scenario/1\"", root["format"]);
+  if (root.contains("name")) s.name = r.string(root["name"], "$.name");
+  if (root.contains("description")) r.string(root["description"], "$.description");
+  if (root.contains("seed")) {
+    if (!root["seed"].is_number_unsigned()) r.failGot("$.seed", "an integer from 0 to 2^64-1", root["seed"]);
+    s.seed = root["seed"].get<uint64_t>();
+  }
+  if (root.contains("scalar")) {
+    auto k = root["scalar"].is_string() ? parseScalarKind(root["scalar"].get<std::string>()) : std::nullopt;
+    if (!k) r.failGot("$.scalar", "one of \"fx32\", \"fx16\", \"float\", \"double\"", root["scalar"]);
+    s.scalar = *k;
+  }
+  if (root.contains("timeStep")) {
+    s.timeStep = r.positive(root["timeStep"], "$.timeStep");
+    if (compare(s.timeStep, Rational{1, 1}) > 0 || compare(s.timeStep, Rational{1, 100000}) < 0)
+      r.failGot("$.timeStep", "a time step from 1e-5 to 1 s", root["timeStep"]);
+  }
+  if (root.contains("field")) parseField(r, root["field"], s.field);
+  if (root.contains("particles")) parseParticles(r, root["particles"], s.particles);
+  if (root.contains("wind")) parseWind(r, root["wind"], s.wind);
+  if (root.contains("terrain")) parseTerrain(r, root["terrain"], s.terrain, readFile);
+  if (s.wind.schedule.empty()) {
+    // An empty schedule is allowed: no wind.
+  }
+  return s;
+}
+
+const std::string& defaultScenarioText() {
+  static const std::string text = R"JSON({
+  "format": "simgrass-scenario/1",
+  "name": "thesis-meadow",
+  "description": "The thesis meadow: 151 x 151 tufts, one particle each, thesis wind schedule, flat ground.",
+  "seed": 1,
+  "scalar": "fx32",
+  "timeStep": "1/60",
+  "field": {
+    "patchesX": 151, "patchesZ": 151,
+    "spacing": 0.25, "jitter": 0.3, "center": [0, 0],
+    "scaleY": 1.0, "scaleXZ": 0.5, "atlasVariants": 4
+  },
+  "particles": {
+    "interpolation": 1,
+    "constraintLength": 1.0,
+    "initialVelocity": [0.2, 0.2, 0.2],
+    "acceleration": [0, 1, 0],
+    "mass": 1,
+    "damping": 0.97,
+    "constraintMode": "thesis",
+    "tiltDrop": [0.2, 0.3, 0.4]
+  },
+  "wind": {
+    "travelSpeed": 7.5,
+    "travel": "direction",
+    "schedule": [
+      {"force": [0, 1, 0.9], "duration": 5},
+      {"force": [0, 0, 0], "duration": 6},
+      {"force": [0, 1, -0.9], "duration": 4},
+      {"force": [0, 0, 0], "duration": 6}
+    ]
+  },
+  "terrain": {"type": "flat", "height": 0}
+}
+)JSON";
+  return text;
+}
+
+}  // namespace sg

@@ -1,0 +1,96 @@
+// Scalar-specific checks: does this scenario fit the chosen number format and the memory?
+#include <cmath>
+#include <sstream>
+
+#include "sim/scenario/scenario.h"
+
+namespace sg {
+namespace {
+double d(const Rational& r) { return r.toDouble(); }
+
+std::string metres(double v) {
+  std::ostringstream o;
+  o.precision(6);
+  o << v << " m";
+  return o.str();
+}
+
+template <class S>
+void checkResolution(const Scenario& s) {
+  using T = ScalarTraits<S>;
+  auto nonZero = [&](const Rational& r, const char* path, const char* what) {
+    auto v = T::fromRational(r);
+    if (!v || *v == S(0))
+      throw ScenarioError(s.sourceName, path,
+                          std::string(what) + " that is non-zero in " + scalarName(T::kind) + ", got " + r.toString());
+  };
+  nonZero(s.timeStep, "$.timeStep", "a time step");
+  nonZero(s.field.spacing, "$.field.spacing", "a spacing");
+  nonZero(s.particles.constraintLength, "$.particles.constraintLength", "a constraint length");
+  nonZero(s.wind.travelSpeed, "$.wind.travelSpeed", "a travel speed");
+  auto perTick = deterministicPow(s.particles.damping, s.timeStep);
+  nonZero(perTick, "$.particles.damping", "a damping whose per-tick factor damping^dt is");
+}
+}  // namespace
+
+uint64_t estimateWorldBytes(const Scenario& s, ScalarKind scalar) {
+  const uint64_t sz = scalar == ScalarKind::Fx16 || scalar == ScalarKind::Float ? 4 : 8;
+  const uint64_t k = uint64_t(s.particles.interpolation);
+  const uint64_t nx = uint64_t(s.field.patchesX), nz = uint64_t(s.field.patchesZ);
+  const uint64_t px = (nx - 1 + k - 1) / k + 1, pz = (nz - 1 + k - 1) / k + 1;
+  const uint64_t perPatch = 3 * sz + 3 + 3 * sz + 1;      // root, rotation+variant, derived
+  const uint64_t perParticle = 9 * sz + 3 * sz;            // p, v, anchor, displacement
+  return nx * nz * perPatch + px * pz * perParticle;
+}
+
+void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimitBytes) {
+  // Memory first: a field that cannot be allocated is the clearest message.
+  const uint64_t bytes = estimateWorldBytes(s, scalar);
+  if (memoryLimitBytes != 0 && bytes > memoryLimitBytes) {
+    std::ostringstream o;
+    o.precision(3);
+    o << "a field that fits in memory: " << s.field.patchesX << " x " << s.field.patchesZ << " patches need "
+      << double(bytes) / (1 << 30) << " GiB, the limit is " << double(memoryLimitBytes) / (1 << 30) << " GiB";
+    throw ScenarioError(s.sourceName, "$.field", o.str());
+  }
+  // Coordinates: every position the world can produce must fit the scalar's safe range.
+  dispatchScalar(scalar, [&]<class S>() {
+    const double limit = ScalarTraits<S>::maxCoordinate;
+    const double k = s.particles.interpolation;
+    const double sp = d(s.field.spacing);
+    const double reachX = std::fabs(d(s.field.centerX)) + sp * (double(s.field.patchesX) + 2 * k) / 2;
+    const double reachZ = std::fabs(d(s.field.centerZ)) + sp * (double(s.field.patchesZ) + 2 * k) / 2;
+    const double tall = d(s.particles.constraintLength) + d(s.field.scaleY);
+    const double ground = s.terrain.flat ? std::fabs(d(s.terrain.flatHeight)) : d(s.terrain.maxHeight);
+    auto check = [&](double reach, const char* path, const char* what) {
+      if (!(reach <= limit)) {
+        throw ScenarioError(s.sourceName, path,
+                            std::string(what) + " within the " + scalarName(ScalarTraits<S>::kind) +
+                                " coordinate range (|coordinate| <= " + metres(limit) + "), this one reaches " +
+                                metres(reach));
+      }
+    };
+    check(reachX, "$.field.patchesX", "a field");
+    check(reachZ, "$.field.patchesZ", "a field");
+    check(ground + tall, s.terrain.flat ? "$.terrain.height" : "$.terrain.maxHeight", "a terrain height");
+    if (!s.terrain.flat) {
+      const double cs = d(s.terrain.cellSize);
+      check(std::fabs(d(s.terrain.centerX)) + cs * s.terrain.heightmap.width / 2, "$.terrain.cellSize", "a heightmap");
+      check(std::fabs(d(s.terrain.centerZ)) + cs * s.terrain.heightmap.height / 2, "$.terrain.cellSize", "a heightmap");
+    }
+    for (size_t i = 0; i < s.wind.schedule.size(); ++i)
+      for (int c = 0; c < 3; ++c)
+        check(std::fabs(d(s.wind.schedule[i].force[c])),
+              ("$.wind.schedule[" + std::to_string(i) + "].force[" + std::to_string(c) + "]").c_str(), "a force");
+    checkResolution<S>(s);
+  });
+  // Every gust lasts at least one tick.
+  for (size_t i = 0; i < s.wind.schedule.size(); ++i) {
+    auto ticks = div(s.wind.schedule[i].duration, s.timeStep);
+    auto n = ticks ? ticks->roundToInt64() : std::nullopt;
+    if (!n || *n < 1 || *n > (int64_t(1) << 40))
+      throw ScenarioError(s.sourceName, "$.wind.schedule[" + std::to_string(i) + "].duration",
+                          "a duration of at least one time step, got " + s.wind.schedule[i].duration.toString() + " s");
+  }
+}
+}  // namespace sg

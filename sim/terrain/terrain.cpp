@@ -1,0 +1,70 @@
+#include "sim/terrain/terrain.h"
+
+namespace sg {
+namespace {
+template <class S>
+S exact(const Rational& r) {
+  return *ScalarTraits<S>::fromRational(r);  // range validated by validateForScalar
+}
+}  // namespace
+
+template <class S>
+Terrain<S>::Terrain(const Scenario::Terrain& t) : flat_(t.flat), flatHeight_(exact<S>(t.flatHeight)) {
+  if (flat_) return;
+  width_ = t.heightmap.width;
+  depth_ = t.heightmap.height;
+  cellSize_ = exact<S>(t.cellSize);
+  invCellSize_ = exact<S>(*div(Rational{1, 1}, t.cellSize));
+  // Sample (0, 0) sits at centre - cellSize * (n - 1) / 2.
+  originX_ = exact<S>(*sub(t.centerX, *mul(t.cellSize, Rational{width_ - 1, 2})));
+  originZ_ = exact<S>(*sub(t.centerZ, *mul(t.cellSize, Rational{depth_ - 1, 2})));
+  S table[256];
+  for (int v = 0; v < 256; ++v) table[v] = exact<S>(*mul(t.maxHeight, *Rational::make(v, 255)));
+  heights_.resize(t.heightmap.samples.size());
+  for (size_t i = 0; i < heights_.size(); ++i) heights_[i] = table[t.heightmap.samples[i]];
+}
+
+template <class S>
+typename Terrain<S>::Cell Terrain<S>::cellAt(S x, S z) const {
+  const S fx = (x - originX_) * invCellSize_;
+  const S fz = (z - originZ_) * invCellSize_;
+  Cell c{floorToInt(fx), floorToInt(fz), fractionalPart(fx), fractionalPart(fz)};
+  // Clamp outside the map: the edge sample extends (t = 0 at the low edge, t = 1 at the high).
+  if (c.ix < 0) { c.ix = 0; c.tx = S(0); }
+  if (c.iz < 0) { c.iz = 0; c.tz = S(0); }
+  if (c.ix > width_ - 2) { c.ix = width_ - 2; c.tx = S(1); }
+  if (c.iz > depth_ - 2) { c.iz = depth_ - 2; c.tz = S(1); }
+  return c;
+}
+
+template <class S>
+S Terrain<S>::heightAt(S x, S z) const {
+  if (flat_) return flatHeight_;
+  const Cell c = cellAt(x, z);
+  const S h0 = lerp(sample(c.ix, c.iz), sample(c.ix + 1, c.iz), c.tx);
+  const S h1 = lerp(sample(c.ix, c.iz + 1), sample(c.ix + 1, c.iz + 1), c.tx);
+  return lerp(h0, h1, c.tz);
+}
+
+template <class S>
+void Terrain<S>::normalAt(S x, S z, S* nx, S* ny, S* nz) const {
+  if (flat_) {
+    *nx = S(0); *ny = S(1); *nz = S(0);
+    return;
+  }
+  const Cell c = cellAt(x, z);
+  const S h00 = sample(c.ix, c.iz), h10 = sample(c.ix + 1, c.iz);
+  const S h01 = sample(c.ix, c.iz + 1), h11 = sample(c.ix + 1, c.iz + 1);
+  const S dhdx = lerp(h10 - h00, h11 - h01, c.tz) * invCellSize_;
+  const S dhdz = lerp(h01 - h00, h11 - h10, c.tx) * invCellSize_;
+  const S len = length3(dhdx, S(1), dhdz);
+  *nx = -dhdx / len;
+  *ny = S(1) / len;
+  *nz = -dhdz / len;
+}
+
+template class Terrain<Fx32>;
+template class Terrain<Fx16>;
+template class Terrain<float>;
+template class Terrain<double>;
+}  // namespace sg

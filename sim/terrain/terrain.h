@@ -1,0 +1,41 @@
+// Ground height and normal: flat, or bilinear over an 8-bit heightmap. Deterministic in every
+// scalar: positions map to cells by multiplying with the precomputed 1/cellSize, heights are the
+// exact rounding of maxHeight * sample / 255. Outside the heightmap the edge samples extend.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "sim/math/scalar_ops.h"
+#include "sim/scenario/scenario.h"
+
+namespace sg {
+
+template <class S>
+class Terrain {
+ public:
+  Terrain() = default;
+  explicit Terrain(const Scenario::Terrain& t);
+
+  bool flat() const { return flat_; }
+  /// Height (m) at world (x, z).
+  S heightAt(S x, S z) const;
+  /// Unit normal at world (x, z): the normalised (-dh/dx, 1, -dh/dz) of the bilinear patch.
+  void normalAt(S x, S z, S* nx, S* ny, S* nz) const;
+
+ private:
+  struct Cell {
+    int64_t ix, iz;  // lower sample indices
+    S tx, tz;        // in [0, 1]
+  };
+  Cell cellAt(S x, S z) const;
+  S sample(int64_t ix, int64_t iz) const { return heights_[size_t(iz) * size_t(width_) + size_t(ix)]; }
+
+  bool flat_ = true;
+  S flatHeight_{};
+  int64_t width_ = 0, depth_ = 0;
+  S cellSize_{}, invCellSize_{}, originX_{}, originZ_{};
+  std::vector<S> heights_;
+};
+
+}  // namespace sg

@@ -1,0 +1,38 @@
+// The stages of one tick, in the thesis order (runPhysics, thesis §9.2), and a hook to time them
+// from outside (the core itself never reads a clock).
+#pragma once
+
+#include <cstdint>
+
+namespace sg {
+
+enum class Stage : uint8_t {
+  Wind = 0,         ///< per-row wind force and particle acceleration        (sim/wind)
+  Collision,        ///< body contacts (rigid-body issue; skipped without bodies)
+  Integrate,        ///< p += v dt; v += a dt; v *= damping^dt              (sim/particles)
+  Constraints,      ///< rod projection back to length L                     (sim/particles)
+  PatchState,       ///< interpolation, tip offsets, tilt levels             (sim/patches)
+  Count
+};
+
+inline const char* stageName(Stage s) {
+  switch (s) {
+    case Stage::Wind: return "wind";
+    case Stage::Collision: return "collision";
+    case Stage::Integrate: return "integrate";
+    case Stage::Constraints: return "constraints";
+    case Stage::PatchState: return "patch-state";
+    case Stage::Count: break;
+  }
+  return "?";
+}
+
+/// Receives stage boundaries; implemented by tools that measure time (replay/).
+class StageObserver {
+ public:
+  virtual ~StageObserver() = default;
+  virtual void stageBegin(Stage stage) = 0;
+  virtual void stageEnd(Stage stage) = 0;
+};
+
+}  // namespace sg

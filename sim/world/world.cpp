@@ -1,0 +1,368 @@
+// World<S>: construction from a scenario, the step as a sequence of stages, and state I/O.
+#include "sim/world/world.h"
+
+#include <bit>
+#include <cstring>
+
+#include "sim/particles/integrate.h"
+#include "sim/particles/rod_constraint.h"
+#include "sim/world/state_sink.h"
+
+namespace sg {
+
+static_assert(std::endian::native == std::endian::little,
+              "the canonical state serialisation writes arrays as they are in memory: little-endian hosts only");
+
+namespace {
+constexpr char kStateMagic[8] = {'S', 'G', 'S', 'T', 'A', 'T', 'E', '1'};
+constexpr uint32_t kStateVersion = 1;
+constexpr size_t kStateHeaderBytes = 40;
+constexpr int64_t kTargetChunkElements = 4096;  // chunk size: fixed by problem size only
+
+template <class S>
+S toS(const Rational& r) {
+  return *ScalarTraits<S>::fromRational(r);  // ranges checked by validateForScalar
+}
+Rational R(std::optional<Rational> r) { return *r; }  // scenario arithmetic on validated values
+
+void hashRational(HashSink& h, const Rational& r) {
+  h.write(&r.num, sizeof r.num);
+  h.write(&r.den, sizeof r.den);
+}
+
+/// Fingerprint of everything that shapes the world (not the name or description), so a saved
+/// state is only restored into a world built from an equivalent scenario.
+uint64_t scenarioFingerprint(const Scenario& s) {
+  HashSink h;
+  const auto& f = s.field;
+  const auto& p = s.particles;
+  const int64_t ints[] = {f.patchesX, f.patchesZ, f.atlasVariants, p.interpolation, int64_t(p.constraintMode),
+                          int64_t(s.wind.travel), int64_t(s.scalar), s.terrain.flat ? 1 : 0,
+                          int64_t(s.terrain.heightmap.width), int64_t(s.terrain.heightmap.height)};
+  h.write(ints, sizeof ints);
+  h.write(&s.seed, sizeof s.seed);
+  for (const Rational* r : {&s.timeStep, &f.spacing, &f.jitter, &f.centerX, &f.centerZ, &f.scaleY, &f.scaleXZ,
+                            &p.constraintLength, &p.mass, &p.damping, &s.wind.travelSpeed, &s.terrain.flatHeight,
+                            &s.terrain.cellSize, &s.terrain.maxHeight, &s.terrain.centerX, &s.terrain.centerZ})
+    hashRational(h, *r);
+  for (int c = 0; c < 3; ++c) {
+    hashRational(h, p.initialVelocity[size_t(c)]);
+    hashRational(h, p.acceleration[size_t(c)]);
+    hashRational(h, p.tiltDrop[size_t(c)]);
+  }
+  for (const WindGust& g : s.wind.schedule) {
+    for (const Rational& r : g.force) hashRational(h, r);
+    hashRational(h, g.duration);
+  }
+  h.write(s.terrain.heightmap.samples.data(), s.terrain.heightmap.samples.size());
+  return h.digest();
+}
+}  // namespace
+
+std::string SimError::message() const {
+  std::string m = "simulation error at tick " + std::to_string(tick) + ", stage '" + stageName(stage) + "'";
+  if (particle >= 0)
+    m += ", particle " + std::to_string(particle) + " (patch " + std::to_string(latticeI) + ", " +
+         std::to_string(latticeJ) + ")";
+  return m + ": " + what;
+}
+
+StateError::StateError(uint64_t offset, const std::string& expected)
+    : std::runtime_error("byte " + std::to_string(offset) + ": expected " + expected), offset_(offset) {}
+
+// ---- construction ---------------------------------------------------------------------------
+
+template <class S>
+World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPool>(threads < 1 ? 1 : threads)) {
+  configHash_ = scenarioFingerprint(s);
+  constraintMode_ = s.particles.constraintMode;
+  const auto& f = s.field;
+  const int k = s.particles.interpolation;
+
+  lattice_.patchesX = f.patchesX;
+  lattice_.patchesZ = f.patchesZ;
+  lattice_.spacing = toS<S>(f.spacing);
+  lattice_.jitterAmplitude = toS<S>(R(mul(f.jitter, f.spacing)));
+  lattice_.originX = toS<S>(R(sub(f.centerX, R(mul(f.spacing, Rational{f.patchesX - 1, 2})))));
+  lattice_.originZ = toS<S>(R(sub(f.centerZ, R(mul(f.spacing, Rational{f.patchesZ - 1, 2})))));
+  lattice_.seed = s.seed;
+  lattice_.atlasVariants = f.atlasVariants;
+  terrain_ = Terrain<S>(s.terrain);
+
+  grid_.k = k;
+  grid_.countX = ParticleGrid::coverCount(f.patchesX, k);
+  grid_.countZ = ParticleGrid::coverCount(f.patchesZ, k);
+
+  particleConsts_.dt = toS<S>(s.timeStep);
+  particleConsts_.invDt = toS<S>(R(div(Rational{1, 1}, s.timeStep)));
+  particleConsts_.dampingPerTick = toS<S>(deterministicPow(s.particles.damping, s.timeStep));
+  particleConsts_.rodLength = toS<S>(s.particles.constraintLength);
+
+  patchConsts_.k = k;
+  for (int t = 0; t < k; ++t) patchConsts_.weight.push_back(toS<S>(Rational{t, k}));
+  patchConsts_.rodLength = particleConsts_.rodLength;
+  patchConsts_.halfRod = toS<S>(R(mul(s.particles.constraintLength, Rational{1, 2})));
+  patchConsts_.scaleY = toS<S>(f.scaleY);
+  for (int i = 0; i < 3; ++i) patchConsts_.drop[i] = toS<S>(s.particles.tiltDrop[size_t(i)]);
+
+  const Rational invMass = R(div(Rational{1, 1}, s.particles.mass));
+  for (const WindGust& g : s.wind.schedule) {
+    windConsts_.forceX.push_back(toS<S>(R(mul(g.force[0], invMass))));
+    windConsts_.forceY.push_back(toS<S>(R(mul(g.force[1], invMass))));
+    windConsts_.forceZ.push_back(toS<S>(R(mul(g.force[2], invMass))));
+  }
+  windConsts_.accX = toS<S>(s.particles.acceleration[0]);
+  windConsts_.accY = toS<S>(s.particles.acceleration[1]);
+  windConsts_.accZ = toS<S>(s.particles.acceleration[2]);
+  windConsts_.dt = particleConsts_.dt;
+  windSchedule_ = WindSchedule::build(s, grid_.countZ, R(mul(f.spacing, Rational::integer(k))));
+
+  // Patches: static attributes from the lattice hash, roots on the terrain.
+  const size_t nPatches = size_t(f.patchesX * f.patchesZ);
+  for (auto* v : {&patches_.rootX, &patches_.rootY, &patches_.rootZ, &patches_.tipOffsetX, &patches_.tipOffsetZ,
+                  &patches_.topY})
+    v->assign(nPatches, S(0));
+  patches_.rotation.assign(nPatches, 0);
+  patches_.variant.assign(nPatches, 0);
+  patches_.tiltLevel.assign(nPatches, 0);
+  const int64_t patchRowsPerChunk = std::max<int64_t>(1, kTargetChunkElements / f.patchesX);
+  pool_->run((f.patchesZ + patchRowsPerChunk - 1) / patchRowsPerChunk, [&](int64_t c, int) {
+    const int64_t j1 = std::min(f.patchesZ, (c + 1) * patchRowsPerChunk);
+    for (int64_t j = c * patchRowsPerChunk; j < j1; ++j)
+      for (int64_t i = 0; i < f.patchesX; ++i) {
+        const size_t p = size_t(j * f.patchesX + i);
+        lattice_.rootXZ(i, j, &patches_.rootX[p], &patches_.rootZ[p]);
+        patches_.rootY[p] = terrain_.heightAt(patches_.rootX[p], patches_.rootZ[p]);
+        patches_.rotation[p] = lattice_.rotation(i, j);
+        patches_.variant[p] = lattice_.variant(i, j);
+      }
+  });
+
+  // Particles: anchored at the root of patch (k a, k b), starting at rest length straight up.
+  particles_.resize(size_t(grid_.size()));
+  const S v0x = toS<S>(s.particles.initialVelocity[0]), v0y = toS<S>(s.particles.initialVelocity[1]),
+          v0z = toS<S>(s.particles.initialVelocity[2]);
+  for (int64_t b = 0; b < grid_.countZ; ++b)
+    for (int64_t a = 0; a < grid_.countX; ++a) {
+      const size_t q = size_t(b * grid_.countX + a);
+      S x, z;
+      lattice_.rootXZ(a * k, b * k, &x, &z);
+      const S y = terrain_.heightAt(x, z);
+      particles_.anchorX[q] = x;
+      particles_.anchorY[q] = y;
+      particles_.anchorZ[q] = z;
+      particles_.px[q] = x;
+      particles_.py[q] = y + particleConsts_.rodLength;
+      particles_.pz[q] = z;
+      particles_.vx[q] = v0x;
+      particles_.vy[q] = v0y;
+      particles_.vz[q] = v0z;
+    }
+  dispX_.assign(size_t(grid_.size()), S(0));
+  dispY_.assign(size_t(grid_.size()), S(0));
+  dispZ_.assign(size_t(grid_.size()), S(0));
+  rowsPerChunk_ = std::max<int64_t>(1, kTargetChunkElements / grid_.countX);
+  setThreads(pool_->threads());
+  takeFixedFaults();
+  updatePatchState();
+}
+
+template <class S>
+void World<S>::setThreads(int threads) {
+  if (threads < 1) threads = 1;
+  if (threads != pool_->threads()) pool_ = std::make_unique<ChunkPool>(threads);
+  rowScratch_.assign(size_t(threads) * size_t(3 * grid_.countX), S(0));
+}
+
+template <class S>
+WorldCounts World<S>::counts() const {
+  return {lattice_.patchesX, lattice_.patchesZ, grid_.countX, grid_.countZ, grid_.k, pool_->threads()};
+}
+
+// ---- the step -------------------------------------------------------------------------------
+
+template <class S>
+template <class Fn>
+bool World<S>::runParticleRows(Stage stage, Fn&& rowKernel) {
+  const int64_t chunks = (grid_.countZ + rowsPerChunk_ - 1) / rowsPerChunk_;
+  std::vector<int64_t> faultAt(size_t(chunks), -1);
+  std::vector<uint32_t> faultBits(size_t(chunks), 0);
+  pool_->run(chunks, [&](int64_t c, int) {
+    takeFixedFaults();
+    const int64_t b1 = std::min(grid_.countZ, (c + 1) * rowsPerChunk_);
+    for (int64_t b = c * rowsPerChunk_; b < b1; ++b) {
+      const int64_t at = rowKernel(b, b * grid_.countX, (b + 1) * grid_.countX);
+      if (at >= 0) {
+        faultAt[size_t(c)] = at;
+        faultBits[size_t(c)] = takeFixedFaults();
+        return;
+      }
+    }
+  });
+  // The first faulting chunk in index order: the same report for any thread count.
+  for (int64_t c = 0; c < chunks; ++c) {
+    if (faultAt[size_t(c)] < 0) continue;
+    const int64_t q = faultAt[size_t(c)];
+    failed_ = true;
+    failure_.tick = tick_;
+    failure_.stage = stage;
+    failure_.particle = q;
+    failure_.latticeI = (q % grid_.countX) * grid_.k;
+    failure_.latticeJ = (q / grid_.countX) * grid_.k;
+    failure_.what = faultBits[size_t(c)] ? fixedFaultName(faultBits[size_t(c)]) : "non-finite value";
+    return false;
+  }
+  return true;
+}
+
+template <class S>
+void World<S>::updatePatchState() {
+  const S rod = particleConsts_.rodLength;
+  pool_->run((grid_.countZ + rowsPerChunk_ - 1) / rowsPerChunk_, [&](int64_t c, int) {
+    const int64_t b1 = std::min(grid_.countZ, (c + 1) * rowsPerChunk_);
+    particleDisplacement(particles_, c * rowsPerChunk_ * grid_.countX, b1 * grid_.countX, rod, dispX_, dispY_, dispZ_);
+  });
+  const int64_t nx = lattice_.patchesX;
+  const int64_t patchRowsPerChunk = std::max<int64_t>(1, kTargetChunkElements / nx);
+  pool_->run((lattice_.patchesZ + patchRowsPerChunk - 1) / patchRowsPerChunk, [&](int64_t c, int worker) {
+    S* scratch = rowScratch_.data() + size_t(worker) * size_t(3 * grid_.countX);
+    const int64_t j1 = std::min(lattice_.patchesZ, (c + 1) * patchRowsPerChunk);
+    for (int64_t j = c * patchRowsPerChunk; j < j1; ++j)
+      updatePatchRow(patches_, nx, j, grid_, dispX_, dispY_, dispZ_, patchConsts_, scratch);
+  });
+}
+
+template <class S>
+StepResult World<S>::step(const TickInput& /*input: camera and bodies arrive with later stages*/,
+                          StageObserver* observer) {
+  if (failed_) return {false, failure_};
+  auto begin = [&](Stage st) { if (observer) observer->stageBegin(st); };
+  auto end = [&](Stage st) { if (observer) observer->stageEnd(st); };
+
+  begin(Stage::Wind);
+  takeFixedFaults();
+  computeRowAcceleration(windSchedule_, windConsts_, tick_, &rowAccel_);
+  if (const uint32_t f = takeFixedFaults()) {
+    failed_ = true;
+    failure_ = SimError{tick_, Stage::Wind, -1, 0, 0, fixedFaultName(f)};
+  }
+  end(Stage::Wind);
+  if (failed_) return {false, failure_};
+
+  // Stage::Collision: no bodies in this scenario kind yet, so the stage costs nothing.
+
+  const ParticleConstants<S>& c = particleConsts_;
+  const bool pbd = constraintMode_ == ConstraintMode::Pbd;
+  begin(Stage::Integrate);
+  const bool integrated = runParticleRows(Stage::Integrate, [&](int64_t row, int64_t b, int64_t e) {
+    const S dvx = rowAccel_.x[size_t(row)], dvy = rowAccel_.y[size_t(row)], dvz = rowAccel_.z[size_t(row)];
+    return pbd ? integrateParticleRow<S, true>(particles_, b, e, dvx, dvy, dvz, c)
+               : integrateParticleRow<S, false>(particles_, b, e, dvx, dvy, dvz, c);
+  });
+  end(Stage::Integrate);
+  if (!integrated) return {false, failure_};
+
+  begin(Stage::Constraints);
+  const bool projected = runParticleRows(Stage::Constraints, [&](int64_t, int64_t b, int64_t e) {
+    return pbd ? projectRodRow<S, true>(particles_, b, e, c) : projectRodRow<S, false>(particles_, b, e, c);
+  });
+  end(Stage::Constraints);
+  if (!projected) return {false, failure_};
+
+  begin(Stage::PatchState);
+  updatePatchState();
+  end(Stage::PatchState);
+
+  ++tick_;
+  return {};
+}
+
+// ---- state I/O --------------------------------------------------------------------------------
+
+template <class S>
+void World<S>::serialise(StateSink& sink) const {
+  // Header (40 bytes, little-endian): magic, version, scalar, k, reserved, fingerprint, tick,
+  // particle count. Then px, py, pz, vx, vy, vz as raw scalar bits, then the count of persistent
+  // patch edits (mower cuts; always 0 until the rigid-body issue).
+  uint8_t header[kStateHeaderBytes] = {};
+  std::memcpy(header, kStateMagic, 8);
+  std::memcpy(header + 8, &kStateVersion, 4);
+  header[12] = uint8_t(ScalarTraits<S>::kind);
+  header[13] = uint8_t(grid_.k);
+  std::memcpy(header + 16, &configHash_, 8);
+  std::memcpy(header + 24, &tick_, 8);
+  const int64_t n = grid_.size();
+  std::memcpy(header + 32, &n, 8);
+  sink.write(header, sizeof header);
+  for (const auto* v : {&particles_.px, &particles_.py, &particles_.pz, &particles_.vx, &particles_.vy, &particles_.vz})
+    sink.write(v->data(), v->size() * sizeof(S));
+  const uint64_t edits = 0;
+  sink.write(&edits, sizeof edits);
+}
+
+template <class S>
+uint64_t World<S>::stateHash() const {
+  HashSink h;
+  serialise(h);
+  return h.digest();
+}
+
+template <class S>
+std::vector<uint8_t> World<S>::saveState() const {
+  ByteSink b;
+  b.bytes.reserve(kStateHeaderBytes + 6 * size_t(grid_.size()) * sizeof(S) + 8);
+  serialise(b);
+  return std::move(b.bytes);
+}
+
+template <class S>
+void World<S>::restoreState(std::span<const uint8_t> bytes) {
+  const size_t n = size_t(grid_.size());
+  const size_t expectedSize = kStateHeaderBytes + 6 * n * sizeof(S) + 8;
+  if (bytes.size() < kStateHeaderBytes) throw StateError(bytes.size(), "a 40-byte state header (the data ends early)");
+  if (std::memcmp(bytes.data(), kStateMagic, 8) != 0) throw StateError(0, "the state magic 'SGSTATE1'");
+  uint32_t version;
+  std::memcpy(&version, bytes.data() + 8, 4);
+  if (version != kStateVersion)
+    throw StateError(8, "state format version " + std::to_string(kStateVersion) + ", got " + std::to_string(version));
+  if (bytes[12] != uint8_t(ScalarTraits<S>::kind))
+    throw StateError(12, std::string("a state of scalar ") + scalarName(ScalarTraits<S>::kind));
+  if (bytes[13] != uint8_t(grid_.k)) throw StateError(13, "interpolation k = " + std::to_string(grid_.k));
+  uint64_t fingerprint;
+  std::memcpy(&fingerprint, bytes.data() + 16, 8);
+  if (fingerprint != configHash_) throw StateError(16, "a state saved from the same scenario (fingerprint differs)");
+  int64_t tick, count;
+  std::memcpy(&tick, bytes.data() + 24, 8);
+  std::memcpy(&count, bytes.data() + 32, 8);
+  if (tick < 0) throw StateError(24, "a non-negative tick");
+  if (count != int64_t(n)) throw StateError(32, std::to_string(n) + " particles, got " + std::to_string(count));
+  if (bytes.size() != expectedSize)
+    throw StateError(std::min(bytes.size(), expectedSize), std::to_string(expectedSize) + " bytes of state, got " +
+                                                               std::to_string(bytes.size()));
+  uint64_t edits;
+  std::memcpy(&edits, bytes.data() + expectedSize - 8, 8);
+  if (edits != 0) throw StateError(expectedSize - 8, "0 persistent patch edits in a state of format version 1");
+  const uint8_t* src = bytes.data() + kStateHeaderBytes;
+  for (auto* v : {&particles_.px, &particles_.py, &particles_.pz, &particles_.vx, &particles_.vy, &particles_.vz}) {
+    std::memcpy(v->data(), src, n * sizeof(S));
+    src += n * sizeof(S);
+  }
+  tick_ = tick;
+  failed_ = false;
+  failure_ = SimError{};
+  updatePatchState();
+}
+
+std::unique_ptr<SimWorld> makeWorld(const Scenario& scenario, int threads, uint64_t memoryLimitBytes) {
+  validateForScalar(scenario, scenario.scalar, memoryLimitBytes);
+  return dispatchScalar(scenario.scalar, [&]<class S>() -> std::unique_ptr<SimWorld> {
+    return std::make_unique<World<S>>(scenario, threads);
+  });
+}
+
+template class World<Fx32>;
+template class World<Fx16>;
+template class World<float>;
+template class World<double>;
+
+}  // namespace sg

@@ -1,0 +1,136 @@
+// The world: owns the grass field, the particles, the terrain and the wind schedule, and
+// advances them one fixed tick at a time. Written once over the scalar type S.
+//
+// Invariants (each one a test in tests/):
+//   * same scenario + same inputs => the same stateHash() after every tick, for any thread
+//     count, build type and compiler (fixed types; float/double: same binary only);
+//   * saveState() -> restoreState() into a fresh world -> continue == never interrupted;
+//   * nothing inside step() reads a clock, a random generator or libm.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "sim/field/grass_field.h"
+#include "sim/particles/particles.h"
+#include "sim/patches/patch_state.h"
+#include "sim/scenario/scenario.h"
+#include "sim/terrain/terrain.h"
+#include "sim/wind/wind.h"
+#include "sim/world/chunk_pool.h"
+#include "sim/world/stage.h"
+#include "sim/world/tick_input.h"
+
+namespace sg {
+
+/// A simulation fault: arithmetic that did not fit the scalar, reported with where it happened.
+struct SimError {
+  int64_t tick = -1;
+  Stage stage = Stage::Count;
+  int64_t particle = -1;  ///< particle index, -1 if not particle-specific
+  int64_t latticeI = 0, latticeJ = 0;  ///< patch coordinates of that particle
+  std::string what;        ///< "fixed-point overflow", "non-finite value", ...
+  std::string message() const;
+};
+
+struct StepResult {
+  bool ok = true;
+  SimError error;
+};
+
+/// A malformed or mismatched saved state; names the byte offset and what was expected.
+class StateError : public std::runtime_error {
+ public:
+  StateError(uint64_t offset, const std::string& expected);
+  uint64_t offset() const { return offset_; }
+ private:
+  uint64_t offset_;
+};
+
+struct WorldCounts {
+  int64_t patchesX = 0, patchesZ = 0;
+  int64_t particlesX = 0, particlesZ = 0;
+  int interpolation = 1;
+  int threads = 1;
+  int64_t patches() const { return patchesX * patchesZ; }
+  int64_t particles() const { return particlesX * particlesZ; }
+};
+
+/// Scalar-erased interface used by tools (command line, replay, viewer).
+class SimWorld {
+ public:
+  virtual ~SimWorld() = default;
+  virtual ScalarKind scalar() const = 0;
+  virtual int64_t tick() const = 0;
+  virtual WorldCounts counts() const = 0;
+  /// Advances one tick. After a fault the world stays failed and every later call fails too.
+  virtual StepResult step(const TickInput& input, StageObserver* observer = nullptr) = 0;
+  /// xxHash3-64 of the canonical little-endian serialisation (the same bytes as saveState()).
+  virtual uint64_t stateHash() const = 0;
+  virtual std::vector<uint8_t> saveState() const = 0;
+  /// Throws StateError when the bytes are not a state of this world's scenario and scalar.
+  virtual void restoreState(std::span<const uint8_t> bytes) = 0;
+  virtual void setThreads(int threads) = 0;
+};
+
+/// Builds a world for scenario.scalar. Throws ScenarioError when the scenario does not fit it.
+std::unique_ptr<SimWorld> makeWorld(const Scenario& scenario, int threads = 1, uint64_t memoryLimitBytes = 0);
+
+template <class S>
+class World final : public SimWorld {
+ public:
+  explicit World(const Scenario& scenario, int threads = 1);
+
+  ScalarKind scalar() const override { return ScalarTraits<S>::kind; }
+  int64_t tick() const override { return tick_; }
+  WorldCounts counts() const override;
+  StepResult step(const TickInput& input, StageObserver* observer = nullptr) override;
+  uint64_t stateHash() const override;
+  std::vector<uint8_t> saveState() const override;
+  void restoreState(std::span<const uint8_t> bytes) override;
+  void setThreads(int threads) override;
+
+  // Read access for tests, tools and the renderer.
+  const ParticleArrays<S>& particles() const { return particles_; }
+  ParticleArrays<S>& mutableParticles() { return particles_; }  ///< tests: set up states
+  const PatchArrays<S>& patches() const { return patches_; }
+  const ParticleGrid& particleGrid() const { return grid_; }
+  const GrassLattice<S>& lattice() const { return lattice_; }
+  const Terrain<S>& terrain() const { return terrain_; }
+  const WindSchedule& wind() const { return windSchedule_; }
+  const RowAccelerationDt<S>& rowAcceleration() const { return rowAccel_; }
+  const ParticleConstants<S>& particleConstants() const { return particleConsts_; }
+  /// Recomputes the derived patch state from the particles (done by step and restore).
+  void updatePatchState();
+
+ private:
+  template <class Fn>
+  bool runParticleRows(Stage stage, Fn&& rowKernel);
+  void serialise(class StateSink& sink) const;
+
+  uint64_t configHash_ = 0;
+  ConstraintMode constraintMode_ = ConstraintMode::Thesis;
+  GrassLattice<S> lattice_;
+  PatchArrays<S> patches_;
+  ParticleGrid grid_;
+  ParticleArrays<S> particles_;
+  ParticleConstants<S> particleConsts_;
+  PatchStateConstants<S> patchConsts_;
+  Terrain<S> terrain_;
+  WindSchedule windSchedule_;
+  WindConstants<S> windConsts_;
+  RowAccelerationDt<S> rowAccel_;
+  std::vector<S> dispX_, dispY_, dispZ_;  ///< per-particle tip displacement (patch-state scratch)
+  std::vector<S> rowScratch_;             ///< per-worker interpolation row
+  int64_t rowsPerChunk_ = 1;
+  int64_t tick_ = 0;
+  bool failed_ = false;
+  SimError failure_;
+  std::unique_ptr<ChunkPool> pool_;
+};
+
+}  // namespace sg
