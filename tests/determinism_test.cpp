@@ -1,0 +1,203 @@
+// Bit-exact promises: golden state hashes (committed, identical for GCC and Clang, Debug and
+// Release, any thread count), save -> restore -> continue == uninterrupted, and clear errors
+// for states that do not belong to the world.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "tests/test_support.h"
+
+namespace sg {
+namespace {
+
+struct GoldenCase {
+  std::string scenario;
+  std::string scalar;
+};
+
+nlohmann::json goldens() {
+  std::ifstream in(test::sourcePath("tests/golden/state_hashes.json"));
+  return nlohmann::json::parse(in);
+}
+
+std::string hex(uint64_t h) {
+  char buf[19];
+  std::snprintf(buf, sizeof buf, "%016llx", (unsigned long long)h);
+  return buf;
+}
+
+std::unique_ptr<SimWorld> build(const GoldenCase& c, int threads) {
+  Scenario s = loadScenarioFile(test::sourcePath("scenarios/" + c.scenario + ".json"));
+  s.scalar = *parseScalarKind(c.scalar);
+  return makeWorld(s, threads);
+}
+
+void runTicks(SimWorld& w, int64_t ticks) {
+  const TickInput input;
+  for (int64_t t = 0; t < ticks; ++t) ASSERT_TRUE(w.step(input).ok) << "tick " << w.tick();
+}
+
+class GoldenHash : public ::testing::TestWithParam<std::tuple<GoldenCase, int>> {};
+
+TEST_P(GoldenHash, MatchesCommittedHashAfter600Ticks) {
+  const auto& [c, threads] = GetParam();
+  const nlohmann::json g = goldens();
+  const std::string expected = g.at(c.scenario + "/" + c.scalar);
+  auto w = build(c, threads);
+  runTicks(*w, g.at("ticks").get<int64_t>());
+  EXPECT_EQ(hex(w->stateHash()), expected)
+      << c.scenario << " " << c.scalar << " with " << threads
+      << " threads. If the physics was meant to change, run .ci/update-goldens and say why in the commit.";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    ScenariosScalarsThreads, GoldenHash,
+    ::testing::Combine(::testing::Values(GoldenCase{"thesis-meadow", "fx32"}, GoldenCase{"thesis-meadow", "fx16"},
+                                         GoldenCase{"hilly-meadow", "fx32"}, GoldenCase{"hilly-meadow", "fx16"}),
+                       ::testing::Values(1, 2, 4)),
+    [](const auto& info) {
+      const GoldenCase& c = std::get<0>(info.param);
+      std::string n = c.scenario + "_" + c.scalar + "_threads" + std::to_string(std::get<1>(info.param));
+      for (char& ch : n) if (ch == '-') ch = '_';
+      return n;
+    });
+
+class SaveRestore : public ::testing::TestWithParam<GoldenCase> {};
+
+TEST_P(SaveRestore, RestoreAtTick300ContinuesToTheGoldenHash) {
+  const GoldenCase c = GetParam();
+  const nlohmann::json g = goldens();
+  auto first = build(c, 2);
+  runTicks(*first, 300);
+  const std::vector<uint8_t> saved = first->saveState();
+  EXPECT_EQ(XXH3_64bits(saved.data(), saved.size()), first->stateHash()) << "hash is over the saved bytes";
+
+  auto fresh = build(c, 1);  // a different thread count on purpose
+  fresh->restoreState(saved);
+  EXPECT_EQ(fresh->tick(), 300);
+  EXPECT_EQ(fresh->stateHash(), first->stateHash());
+  runTicks(*fresh, 300);
+  EXPECT_EQ(hex(fresh->stateHash()), g.at(c.scenario + "/" + c.scalar).get<std::string>());
+}
+
+INSTANTIATE_TEST_SUITE_P(Goldens, SaveRestore,
+                         ::testing::Values(GoldenCase{"thesis-meadow", "fx32"}, GoldenCase{"thesis-meadow", "fx16"},
+                                           GoldenCase{"hilly-meadow", "fx32"}, GoldenCase{"hilly-meadow", "fx16"}),
+                         [](const auto& info) {
+                           std::string n = info.param.scenario + "_" + info.param.scalar;
+                           for (char& ch : n) if (ch == '-') ch = '_';
+                           return n;
+                         });
+
+// float and double promise only same-binary reproducibility, but for any thread count.
+TEST(FloatDeterminism, SameHashForOneTwoAndFourThreads) {
+  for (const char* scalar : {"float", "double"}) {
+    uint64_t reference = 0;
+    for (int threads : {1, 2, 4}) {
+      auto w = build({"thesis-meadow", scalar}, threads);
+      runTicks(*w, 200);
+      if (threads == 1) reference = w->stateHash();
+      EXPECT_EQ(w->stateHash(), reference) << scalar << " with " << threads << " threads";
+    }
+  }
+}
+
+TEST(Determinism, EveryTickHashIdenticalAcrossRunsAndThreadCounts) {
+  auto a = build({"thesis-meadow", "fx32"}, 1);
+  auto b = build({"thesis-meadow", "fx32"}, 3);
+  const TickInput input;
+  for (int t = 0; t < 120; ++t) {
+    ASSERT_TRUE(a->step(input).ok);
+    ASSERT_TRUE(b->step(input).ok);
+    ASSERT_EQ(a->stateHash(), b->stateHash()) << "diverged at tick " << a->tick();
+  }
+  b->setThreads(2);  // changing the thread count mid-run changes nothing either
+  for (int t = 0; t < 30; ++t) {
+    ASSERT_TRUE(a->step(input).ok);
+    ASSERT_TRUE(b->step(input).ok);
+  }
+  EXPECT_EQ(a->stateHash(), b->stateHash());
+}
+
+TEST(Determinism, HashChangesWhenTheStateChanges) {
+  auto a = build({"thesis-meadow", "fx32"}, 1);
+  const uint64_t h0 = a->stateHash();
+  ASSERT_TRUE(a->step(TickInput{}).ok);
+  EXPECT_NE(a->stateHash(), h0) << "the tick counter and the particles are part of the hash";
+  auto& w = dynamic_cast<World<Fx32>&>(*a);
+  const uint64_t h1 = w.stateHash();
+  w.mutableParticles().vz[12345] += Fx32::epsilon();
+  EXPECT_NE(w.stateHash(), h1) << "one ulp of one velocity changes the hash";
+}
+
+// ---- bad saved states: one clear error with the byte offset ------------------------------------
+
+class BadState : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    world = build({"thesis-meadow", "fx32"}, 1);
+    runTicks(*world, 3);
+    good = world->saveState();
+  }
+  void expectError(const std::vector<uint8_t>& bytes, uint64_t offset, const std::string& fragment) {
+    auto fresh = build({"thesis-meadow", "fx32"}, 1);
+    try {
+      fresh->restoreState(bytes);
+      FAIL() << "accepted a bad state; expected an error at byte " << offset;
+    } catch (const StateError& e) {
+      EXPECT_EQ(e.offset(), offset) << e.what();
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  }
+  std::unique_ptr<SimWorld> world;
+  std::vector<uint8_t> good;
+};
+
+TEST_F(BadState, TruncatedHeader) { expectError({good.begin(), good.begin() + 10}, 10, "header"); }
+TEST_F(BadState, WrongMagic) {
+  auto b = good;
+  b[0] = 'X';
+  expectError(b, 0, "magic");
+}
+TEST_F(BadState, WrongVersion) {
+  auto b = good;
+  b[8] = 99;
+  expectError(b, 8, "version");
+}
+TEST_F(BadState, WrongScalar) {
+  auto b = good;
+  b[12] = uint8_t(ScalarKind::Fx16);
+  expectError(b, 12, "fx32");
+}
+TEST_F(BadState, OtherScenario) {
+  auto b = good;
+  b[16] ^= 1;
+  expectError(b, 16, "same scenario");
+}
+TEST_F(BadState, TruncatedBody) {
+  auto b = good;
+  b.resize(b.size() - 100);
+  expectError(b, b.size(), "bytes of state");
+}
+TEST_F(BadState, ExtraBytes) {
+  auto b = good;
+  b.push_back(0);
+  expectError(b, good.size(), "bytes of state");
+}
+TEST_F(BadState, ParticleCount) {
+  auto b = good;
+  b[32] ^= 1;
+  expectError(b, 32, "particles");
+}
+TEST_F(BadState, FailedRestoreLeavesTheWorldUsable) {
+  auto b = good;
+  b[0] = 'X';
+  const uint64_t before = world->stateHash();
+  EXPECT_THROW(world->restoreState(b), StateError);
+  EXPECT_EQ(world->stateHash(), before);
+  EXPECT_TRUE(world->step(TickInput{}).ok);
+}
+
+}  // namespace
+}  // namespace sg

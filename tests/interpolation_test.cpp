@@ -1,0 +1,103 @@
+// Interpolation (one particle per k x k patches): owners match their particle exactly, the others
+// equal the bilinear blend of the four particles around them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tests/test_support.h"
+
+namespace sg {
+namespace {
+
+template <class S>
+double d(S v) { return ScalarTraits<S>::toDouble(v); }
+
+template <class S>
+void checkInterpolation(int k, int64_t nx, int64_t nz, double tolerance) {
+  Scenario s = test::thesisMeadow();
+  s.field.patchesX = nx;
+  s.field.patchesZ = nz;
+  s.particles.interpolation = k;
+  s.wind.travelSpeed = Rational{1, 2};  // slow gust: neighbouring rows differ a lot
+  s.scalar = ScalarTraits<S>::kind;
+  World<S> w(s, 1);
+  for (int t = 0; t < 90; ++t) ASSERT_TRUE(w.step(TickInput{}).ok);
+  const auto& p = w.particles();
+  const auto& patches = w.patches();
+  const ParticleGrid& g = w.particleGrid();
+  EXPECT_EQ(g.countX, (nx - 1 + k - 1) / k + 1);
+  const S rod = w.particleConstants().rodLength;
+  auto disp = [&](int64_t a, int64_t b, int c) {
+    const size_t q = size_t(b * g.countX + a);
+    if (c == 0) return d(p.px[q] - p.anchorX[q]);
+    if (c == 1) return d(p.py[q] - p.anchorY[q] - rod);
+    return d(p.pz[q] - p.anchorZ[q]);
+  };
+  int owners = 0, blended = 0;
+  double moved = 0;
+  for (int64_t j = 0; j < nz; ++j) {
+    for (int64_t i = 0; i < nx; ++i) {
+      const size_t q = size_t(j * nx + i);
+      const int64_t a = i / k, b = j / k;
+      if (i % k == 0 && j % k == 0) {
+        // Exactly the particle's displacement, not merely close.
+        const size_t pi = size_t(b * g.countX + a);
+        EXPECT_EQ(patches.tipOffsetX[q], p.px[pi] - p.anchorX[pi]) << i << "," << j;
+        EXPECT_EQ(patches.tipOffsetZ[q], p.pz[pi] - p.anchorZ[pi]) << i << "," << j;
+        ++owners;
+        continue;
+      }
+      const double tx = double(i % k) / k, tz = double(j % k) / k;
+      for (int c : {0, 2}) {
+        const double v00 = disp(a, b, c), v10 = tx > 0 ? disp(a + 1, b, c) : v00;
+        const double v01 = tz > 0 ? disp(a, b + 1, c) : v00;
+        const double v11 = tx > 0 && tz > 0 ? disp(a + 1, b + 1, c) : (tx > 0 ? v10 : v01);
+        const double expected = (1 - tx) * (1 - tz) * v00 + tx * (1 - tz) * v10 + (1 - tx) * tz * v01 + tx * tz * v11;
+        const double got = d(c == 0 ? patches.tipOffsetX[q] : patches.tipOffsetZ[q]);
+        EXPECT_NEAR(got, expected, tolerance) << "patch " << i << "," << j << " component " << c;
+        moved = std::max(moved, std::fabs(expected));
+      }
+      ++blended;
+    }
+  }
+  EXPECT_GT(owners, 0);
+  if (k == 1) {
+    EXPECT_EQ(owners, nx * nz) << "with k = 1 every patch owns its particle";
+    return;
+  }
+  EXPECT_GT(blended, 0);
+  EXPECT_GT(moved, 0.05) << "the wind must have bent the tufts for this test to mean anything";
+}
+
+// Tolerances: the blend is two lerps (z then x), each a subtraction, a product rounded once and
+// an addition; weights t/k are exact for k = 2, 4 and rounded (1/2 ulp) for k = 3. Displacements
+// are below 1 m, so the error stays within a few ulp: 8 ulp allowed.
+TEST(Interpolation, K2Fx32) { checkInterpolation<Fx32>(2, 21, 17, 8.0 / 4294967296.0); }
+TEST(Interpolation, K3Fx32) { checkInterpolation<Fx32>(3, 22, 20, 8.0 / 4294967296.0); }
+TEST(Interpolation, K4Fx32) { checkInterpolation<Fx32>(4, 25, 19, 8.0 / 4294967296.0); }
+TEST(Interpolation, K2Fx16) { checkInterpolation<Fx16>(2, 21, 17, 8.0 / 65536.0); }
+TEST(Interpolation, K3Double) { checkInterpolation<double>(3, 22, 20, 1e-14); }
+TEST(Interpolation, K1IsIdentity) { checkInterpolation<Fx32>(1, 9, 9, 0.0); }
+
+TEST(PatchState, SmallerCapAndTiltLevelsFollowTheThesis) {
+  Scenario s = test::thesisMeadow();
+  s.field.patchesX = 5;
+  s.field.patchesZ = 1;
+  s.wind.schedule.clear();
+  World<double> w(s, 1);
+  auto& p = w.mutableParticles();
+  // Sink the tips by 0.1, 0.25, 0.35, 0.45 and 0.9 m (moving x keeps the rod length irrelevant
+  // here: patch state reads positions, not lengths).
+  const double sink[5] = {0.1, 0.25, 0.35, 0.45, 0.9};
+  for (int i = 0; i < 5; ++i) p.py[size_t(i)] = p.anchorY[size_t(i)] + 1.0 - sink[i];
+  w.updatePatchState();
+  const int expectedTilt[5] = {0, 1, 2, 3, 3};
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(w.patches().tiltLevel[size_t(i)], expectedTilt[i]) << "sink " << sink[i];
+    const double smaller = std::min(sink[i], 0.5);  // capped at L / 2
+    EXPECT_NEAR(w.patches().topY[size_t(i)], w.patches().rootY[size_t(i)] + 1.0 - smaller, 1e-15);
+  }
+}
+
+}  // namespace
+}  // namespace sg

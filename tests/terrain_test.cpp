@@ -1,0 +1,136 @@
+// Terrain: exact heights at the samples, bilinear in between, analytic normals on a plane, edge
+// clamping, and patch roots on the ground.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <iterator>
+
+#include "tests/test_support.h"
+
+namespace sg {
+namespace {
+
+Scenario::Terrain rampTerrain(int w, int h) {
+  Scenario::Terrain t;
+  t.flat = false;
+  t.cellSize = Rational{1, 2};
+  t.maxHeight = Rational{51, 10};  // 5.1 m: sample value v gives v / 50 m
+  t.heightmap.width = w;
+  t.heightmap.height = h;
+  for (int z = 0; z < h; ++z)
+    for (int x = 0; x < w; ++x) t.heightmap.samples.push_back(uint8_t(4 * x + z));
+  return t;
+}
+
+TEST(Terrain, ExactHeightsAtSamplesFx32) {
+  Terrain<Fx32> t(rampTerrain(9, 5));
+  // Sample (x, z) sits at ((x - 4) * 0.5, (z - 2) * 0.5): exactly representable.
+  for (int z = 0; z < 5; ++z)
+    for (int x = 0; x < 9; ++x) {
+      const Fx32 wx = Fx32(x - 4) / Fx32(2), wz = Fx32(z - 2) / Fx32(2);
+      const Fx32 expected = *ScalarTraits<Fx32>::fromRational(*mul(Rational{51, 10}, *Rational::make(4 * x + z, 255)));
+      EXPECT_EQ(t.heightAt(wx, wz), expected) << x << "," << z;
+    }
+}
+
+TEST(Terrain, BilinearBetweenSamplesDouble) {
+  Terrain<double> t(rampTerrain(9, 5));
+  // The ramp is linear (h = (4x + z) / 50 in sample units): bilinear reproduces it everywhere.
+  for (double wx = -1.9; wx < 1.9; wx += 0.173)
+    for (double wz = -0.9; wz < 0.9; wz += 0.131) {
+      const double x = wx / 0.5 + 4, z = wz / 0.5 + 2;
+      EXPECT_NEAR(t.heightAt(wx, wz), (4 * x + z) / 50.0, 1e-13);
+    }
+}
+
+TEST(Terrain, NormalOfAPlane) {
+  Terrain<double> td(rampTerrain(9, 5));
+  Terrain<Fx32> tf(rampTerrain(9, 5));
+  // dh/dx = 4 / 50 / 0.5 = 0.16, dh/dz = 1 / 50 / 0.5 = 0.04.
+  const double n = std::sqrt(0.16 * 0.16 + 1 + 0.04 * 0.04);
+  double nx, ny, nz;
+  td.normalAt(0.3, -0.2, &nx, &ny, &nz);
+  EXPECT_NEAR(nx, -0.16 / n, 1e-14);
+  EXPECT_NEAR(ny, 1 / n, 1e-14);
+  EXPECT_NEAR(nz, -0.04 / n, 1e-14);
+  Fx32 fx, fy, fz;
+  tf.normalAt(Fx32::fromDouble(0.3), Fx32::fromDouble(-0.2), &fx, &fy, &fz);
+  // A handful of roundings of 2^-33 each, then a division: 1e-8 is ~40 ulp of slack.
+  EXPECT_NEAR(fx.toDouble(), -0.16 / n, 1e-8);
+  EXPECT_NEAR(fy.toDouble(), 1 / n, 1e-8);
+  EXPECT_NEAR(fz.toDouble(), -0.04 / n, 1e-8);
+}
+
+TEST(Terrain, EdgeSamplesExtendOutsideTheMap) {
+  Terrain<double> t(rampTerrain(9, 5));
+  EXPECT_DOUBLE_EQ(t.heightAt(-100, -100), 0.0);
+  EXPECT_NEAR(t.heightAt(100, 100), (4 * 8 + 4) / 50.0, 1e-14);
+  EXPECT_NEAR(t.heightAt(-100, 0), 2 / 50.0, 1e-14);
+}
+
+TEST(Terrain, FlatTerrain) {
+  Scenario::Terrain flat;
+  flat.flatHeight = Rational{3, 2};
+  Terrain<Fx16> t(flat);
+  EXPECT_EQ(t.heightAt(Fx16(100), Fx16(-7)), Fx16(3) / Fx16(2));
+  Fx16 nx, ny, nz;
+  t.normalAt(Fx16(0), Fx16(0), &nx, &ny, &nz);
+  EXPECT_EQ(ny, Fx16(1));
+}
+
+TEST(Terrain, HillsPngDecodesAndRootsSitOnTheGround) {
+  std::ifstream in(test::sourcePath("scenarios/hills.png"), std::ios::binary);
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  Heightmap hm;
+  std::string error;
+  ASSERT_TRUE(decodeHeightmapPng(bytes, &hm, &error)) << error;
+  EXPECT_EQ(hm.width, 129);
+  EXPECT_EQ(hm.height, 129);
+
+  Scenario s = loadScenarioFile(test::sourcePath("scenarios/hilly-meadow.json"));
+  World<Fx32> w(s, 1);
+  const auto& p = w.patches();
+  double lo = 1e9, hi = -1e9;
+  for (size_t i = 0; i < p.rootY.size(); ++i) {
+    ASSERT_EQ(p.rootY[i], w.terrain().heightAt(p.rootX[i], p.rootZ[i]));
+    lo = std::min(lo, p.rootY[i].toDouble());
+    hi = std::max(hi, p.rootY[i].toDouble());
+  }
+  EXPECT_GT(hi - lo, 1.0) << "the meadow stands on hills";
+  // Particles start at rest length above their anchors.
+  const auto& q = w.particles();
+  EXPECT_EQ(q.py[100] - q.anchorY[100], Fx32(1));
+}
+
+TEST(Lattice, PatchAttributesArePureFunctionsOfTheLatticeCoordinates) {
+  Scenario s = test::thesisMeadow();
+  World<Fx32> a(s, 1);
+  GrassLattice<Fx32> lattice = a.lattice();
+  // Regenerate patch (37, 91) on its own: identical to the stored one.
+  Fx32 x, z;
+  lattice.rootXZ(37, 91, &x, &z);
+  const size_t q = size_t(91 * 151 + 37);
+  EXPECT_EQ(x, a.patches().rootX[q]);
+  EXPECT_EQ(z, a.patches().rootZ[q]);
+  EXPECT_EQ(lattice.rotation(37, 91), a.patches().rotation[q]);
+  EXPECT_EQ(lattice.variant(37, 91), a.patches().variant[q]);
+  // Jitter stays inside +-0.3 * spacing and is not constant.
+  double minJ = 1, maxJ = -1;
+  for (int64_t i = 0; i < 151; ++i) {
+    lattice.rootXZ(i, 3, &x, &z);
+    const double jitter = x.toDouble() - (lattice.originX.toDouble() + 0.25 * double(i));
+    minJ = std::min(minJ, jitter);
+    maxJ = std::max(maxJ, jitter);
+  }
+  EXPECT_GE(minJ, -0.075);
+  EXPECT_LE(maxJ, 0.075);
+  EXPECT_GT(maxJ - minJ, 0.1);
+  // A different seed gives a different meadow.
+  s.seed = 2;
+  World<Fx32> b(s, 1);
+  EXPECT_NE(a.patches().rootX[q], b.patches().rootX[q]);
+}
+
+}  // namespace
+}  // namespace sg

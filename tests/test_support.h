@@ -1,0 +1,34 @@
+// Shared helpers for the test suites.
+#pragma once
+
+#include <cstdlib>
+#include <string>
+
+#include <xxhash.h>
+
+#include "replay/scenario_files.h"
+#include "sim/scenario/scenario.h"
+#include "sim/world/world.h"
+
+namespace sg::test {
+
+inline std::string sourcePath(const std::string& rel) { return std::string(SIMGRASS_SOURCE_DIR) + "/" + rel; }
+
+/// True in slow builds (Debug + sanitizers): long-running tests shorten themselves there.
+inline bool slowBuild() { return std::getenv("SIMGRASS_SLOW_BUILD") != nullptr; }
+
+/// The built-in thesis meadow, parsed.
+inline Scenario thesisMeadow() { return parseScenario(defaultScenarioText(), "<built-in>", {}); }
+
+/// A scenario with one tuft (1 x 1 patches), no wind, given constraint mode.
+inline Scenario singleTuft(ConstraintMode mode) {
+  Scenario s = thesisMeadow();
+  s.field.patchesX = s.field.patchesZ = 1;
+  s.field.jitter = Rational{0, 1};
+  s.particles.constraintMode = mode;
+  s.particles.initialVelocity = {Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
+  s.wind.schedule.clear();
+  return s;
+}
+
+}  // namespace sg::test
