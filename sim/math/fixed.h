@@ -150,20 +150,48 @@ class Fixed {
     return static_cast<Raw>(w);  // modular since C++20: defined
   }
   /// p / 2^Frac rounded to nearest, ties away from zero. Requires |p| < 2^(2*kRawBits-1).
+  /// For p < 0, -floor((|p| + h) / D) == floor((p + h - 1) / D) with D = 2h, so one add of the
+  /// sign (0 or -1) and an arithmetic shift (floor) give the symmetric rounding without a branch.
   static constexpr Wide roundShift(Wide p) noexcept {
     const Wide sign = p >> (2 * kRawBits - 1);  // 0 or -1 (arithmetic shift, defined in C++20)
-    Wide mag = (p ^ sign) - sign;
-    mag = (mag + (Wide(1) << (Frac - 1))) >> Frac;
-    return (mag ^ sign) - sign;
+    return (p + (Wide(1) << (Frac - 1)) + sign) >> Frac;
   }
   /// n / d rounded to nearest, ties away from zero. d != 0; |n|, |d| < 2^(2*kRawBits-1).
   static constexpr Wide divRound(Wide n, Wide d) noexcept {
+    if constexpr (sizeof(Wide) == 16) {
+      // Fast path for Q32.32: magnitudes with |n| / |d| < 2^64 divide with one 128/64 divq.
+      // Same exact quotient and remainder as the generic path, so the same bits.
+      using U = unsigned __int128;
+      const U un = n < 0 ? U(0) - U(n) : U(n);
+      const U ud = d < 0 ? U(0) - U(d) : U(d);
+      if (!std::is_constant_evaluated() && (ud >> 64) == 0 && uint64_t(un >> 64) < uint64_t(ud)) {
+        uint64_t r;
+        uint64_t q = udiv128by64(uint64_t(un >> 64), uint64_t(un), uint64_t(ud), &r);
+        const bool up = r >= uint64_t(ud) - r;  // 2r >= d without overflow
+        const Wide mag = Wide(q) + (up ? 1 : 0);
+        return ((n < 0) != (d < 0)) ? -mag : mag;
+      }
+    }
     Wide q = n / d;
-    const Wide r = n % d;
+    const Wide r = n - q * d;  // remainder without a second wide division
     const Wide absR = r < 0 ? -r : r;
     const Wide absD = d < 0 ? -d : d;
     if (absR >= absD - absR) q += ((n < 0) != (d < 0)) ? -1 : 1;
     return q;
+  }
+
+  /// (hi:lo) / d for hi < d (the quotient fits 64 bits); the remainder goes to *rem.
+  static uint64_t udiv128by64(uint64_t hi, uint64_t lo, uint64_t d, uint64_t* rem) noexcept {
+#if defined(__x86_64__)
+    uint64_t q, r;
+    __asm__("divq %4" : "=a"(q), "=d"(r) : "a"(lo), "d"(hi), "rm"(d));
+    *rem = r;
+    return q;
+#else
+    const unsigned __int128 n = (static_cast<unsigned __int128>(hi) << 64) | lo;
+    *rem = uint64_t(n % d);
+    return uint64_t(n / d);
+#endif
   }
 
  private:

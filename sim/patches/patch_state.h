@@ -37,6 +37,18 @@ inline void particleDisplacement(const ParticleArrays<S>& p, int64_t begin, int6
   }
 }
 
+/// Writes one patch's derived state from its tip displacement (ddx, ddy, ddz).
+template <class S>
+inline void writePatch(PatchArrays<S>& patches, size_t p, S ddx, S ddy, S ddz, const PatchStateConstants<S>& c) {
+  const S zero(0);
+  patches.tipOffsetX[p] = ddx;
+  patches.tipOffsetZ[p] = ddz;
+  const S sink = zero - ddy;
+  const S smaller = sink < zero ? zero : (sink > c.halfRod ? c.halfRod : sink);
+  patches.topY[p] = patches.rootY[p] + c.scaleY - smaller;
+  patches.tiltLevel[p] = uint8_t(sink > c.drop[2] ? 3 : sink > c.drop[1] ? 2 : sink > c.drop[0] ? 1 : 0);
+}
+
 /// Derived state of patch row j. `scratch` holds 3 * grid.countX values.
 template <class S>
 inline void updatePatchRow(PatchArrays<S>& patches, int64_t patchesX, int64_t j, const ParticleGrid& grid,
@@ -64,24 +76,22 @@ inline void updatePatchRow(PatchArrays<S>& patches, int64_t patchesX, int64_t j,
     rz = bz;
   }
   const int64_t row = j * patchesX;
-  const S zero(0);
-  for (int64_t i = 0; i < patchesX; ++i) {
-    const int64_t a0 = i / k, tx = i % k;
-    S ddx = rx[a0], ddy = ry[a0], ddz = rz[a0];
-    if (tx != 0) {
-      const S w = c.weight[size_t(tx)];
-      ddx = lerp(ddx, rx[a0 + 1], w);
-      ddy = lerp(ddy, ry[a0 + 1], w);
-      ddz = lerp(ddz, rz[a0 + 1], w);
+  if (k == 1) {  // every patch owns its particle
+    for (int64_t i = 0; i < patchesX; ++i) writePatch(patches, size_t(row + i), rx[i], ry[i], rz[i], c);
+    return;
+  }
+  // Walk particle columns a and the k patches after each (i = a k + t): no division per patch.
+  for (int64_t a = 0, i = 0; i < patchesX; ++a) {
+    for (int t = 0; t < k && i < patchesX; ++t, ++i) {
+      S ddx = rx[a], ddy = ry[a], ddz = rz[a];
+      if (t != 0) {
+        const S w = c.weight[size_t(t)];
+        ddx = lerp(ddx, rx[a + 1], w);
+        ddy = lerp(ddy, ry[a + 1], w);
+        ddz = lerp(ddz, rz[a + 1], w);
+      }
+      writePatch(patches, size_t(row + i), ddx, ddy, ddz, c);
     }
-    const size_t p = size_t(row + i);
-    patches.tipOffsetX[p] = ddx;
-    patches.tipOffsetZ[p] = ddz;
-    S smaller = zero - ddy;
-    smaller = smaller < zero ? zero : (smaller > c.halfRod ? c.halfRod : smaller);
-    patches.topY[p] = patches.rootY[p] + c.scaleY - smaller;
-    const S sink = zero - ddy;
-    patches.tiltLevel[p] = uint8_t(sink > c.drop[2] ? 3 : sink > c.drop[1] ? 2 : sink > c.drop[0] ? 1 : 0);
   }
 }
 
