@@ -4,6 +4,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <cstdio>
 #include <sstream>
 
 #include "sim/scenario/scenario.h"
@@ -53,9 +54,16 @@ class RawNumberCollector : public nlohmann::json_sax<json> {
     frames_.pop_back();
     return after();
   }
-  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override {
-    return false;  // the DOM parse reports syntax errors with their position
+  bool parse_error(std::size_t position, const std::string& token, const nlohmann::detail::exception& e) override {
+    errorByte = position;
+    errorToken = token;
+    errorPath = path();
+    numberOverflow = e.id == 406;  // out_of_range.406: a number beyond double, e.g. 1e400
+    return false;
   }
+  std::size_t errorByte = 0;
+  std::string errorToken, errorPath;
+  bool numberOverflow = false;
 
  private:
   struct Frame {
@@ -297,23 +305,48 @@ std::string lineColumn(const std::string& text, size_t byte) {
 }
 }  // namespace
 
+namespace {
+/// Escapes control characters (a newline in a key or file name must not split the line).
+std::string oneLine(const std::string& s) {
+  std::string out;
+  for (unsigned char c : s) {
+    if (c == '\n') out += "\\n";
+    else if (c == '\r') out += "\\r";
+    else if (c == '\t') out += "\\t";
+    else if (c < 0x20 || c == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out += char(c);
+    }
+  }
+  return out;
+}
+}  // namespace
+
 ScenarioError::ScenarioError(const std::string& file, const std::string& path, const std::string& expected)
-    : std::runtime_error(file + ": " + path + ": expected " + expected), file_(file), path_(path) {}
+    : std::runtime_error(oneLine(file + ": " + path + ": expected " + expected)), file_(file), path_(path) {}
 
 Scenario parseScenario(const std::string& text, const std::string& sourceName, const ScenarioFileReader& readFile) {
+  // The SAX pass first: it knows the JSON path of a number that overflows a double.
+  RawNumberCollector collector;
+  const bool wellFormed = json::sax_parse(text, &collector);
+  if (!wellFormed && collector.numberOverflow)
+    throw ScenarioError(sourceName, collector.errorPath,
+                        "a number between 1e-36 and 1e36 in magnitude, got " + collector.errorToken);
   json root;
   try {
     root = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
     // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: ..."
     std::string what = e.what();
-    const size_t colon = what.find(": ", what.find("parse error"));
+    const size_t colon = what.find(": ", what.find("error"));
     std::string detail = colon == std::string::npos ? what : what.substr(colon + 2);
-    throw ScenarioError(sourceName, "byte " + std::to_string(e.byte) + " (" + lineColumn(text, e.byte ? e.byte - 1 : 0) + ")",
+    const size_t byte = collector.errorByte;
+    throw ScenarioError(sourceName, "byte " + std::to_string(byte) + " (" + lineColumn(text, byte ? byte - 1 : 0) + ")",
                         "valid JSON (" + detail + ")");
   }
-  RawNumberCollector collector;
-  json::sax_parse(text, &collector);
   if (!collector.duplicatePath.empty())
     throw ScenarioError(sourceName, collector.duplicatePath, "each key once (this key appears twice)");
 

@@ -82,15 +82,51 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
       for (int c = 0; c < 3; ++c)
         check(std::fabs(d(s.wind.schedule[i].force[c])),
               ("$.wind.schedule[" + std::to_string(i) + "].force[" + std::to_string(c) + "]").c_str(), "a force");
+    // Every other number the world converts must fit too (velocities, accelerations, ...).
+    auto fits = [&](const Rational& r, const std::string& path) {
+      if (!ScalarTraits<S>::fromRational(r) || !(std::fabs(r.toDouble()) <= limit))
+        throw ScenarioError(s.sourceName, path,
+                            "a value within the " + std::string(scalarName(ScalarTraits<S>::kind)) +
+                                " range (|value| <= " + metres(limit).substr(0, metres(limit).size() - 2) +
+                                "), got " + r.toString());
+    };
+    const auto& pa = s.particles;
+    for (int c = 0; c < 3; ++c) {
+      const std::string i = "[" + std::to_string(c) + "]";
+      fits(pa.initialVelocity[size_t(c)], "$.particles.initialVelocity" + i);
+      fits(pa.acceleration[size_t(c)], "$.particles.acceleration" + i);
+      fits(pa.tiltDrop[size_t(c)], "$.particles.tiltDrop" + i);
+    }
+    fits(pa.constraintLength, "$.particles.constraintLength");
+    fits(pa.mass, "$.particles.mass");
+    fits(*div(Rational{1, 1}, pa.mass), "$.particles.mass");
+    fits(*div(Rational{1, 1}, s.timeStep), "$.timeStep");
+    fits(s.field.scaleY, "$.field.scaleY");
+    fits(s.field.scaleXZ, "$.field.scaleXZ");
+    fits(s.field.spacing, "$.field.spacing");
+    fits(s.wind.travelSpeed, "$.wind.travelSpeed");
+    for (size_t i = 0; i < s.wind.schedule.size(); ++i)
+      for (int c = 0; c < 3; ++c) {
+        auto perMass = div(s.wind.schedule[i].force[size_t(c)], pa.mass);
+        const std::string path = "$.wind.schedule[" + std::to_string(i) + "].force[" + std::to_string(c) + "]";
+        if (!perMass) throw ScenarioError(s.sourceName, path, "a force of representable size");
+        fits(*perMass, path);
+      }
+    if (!s.terrain.flat) {
+      fits(s.terrain.cellSize, "$.terrain.cellSize");
+      fits(*div(Rational{1, 1}, s.terrain.cellSize), "$.terrain.cellSize");
+    }
     checkResolution<S>(s);
   });
-  // Every gust lasts at least one tick.
+  // Every gust lasts at least one tick (a shorter one would be lengthened silently), and its
+  // length in ticks is the duration rounded to the nearest tick.
   for (size_t i = 0; i < s.wind.schedule.size(); ++i) {
     auto ticks = div(s.wind.schedule[i].duration, s.timeStep);
     auto n = ticks ? ticks->roundToInt64() : std::nullopt;
-    if (!n || *n < 1 || *n > (int64_t(1) << 40))
+    if (!n || compare(s.wind.schedule[i].duration, s.timeStep) < 0 || *n > (int64_t(1) << 40))
       throw ScenarioError(s.sourceName, "$.wind.schedule[" + std::to_string(i) + "].duration",
-                          "a duration of at least one time step, got " + s.wind.schedule[i].duration.toString() + " s");
+                          "a duration of at least one time step (" + s.timeStep.toString() + " s), got " +
+                              s.wind.schedule[i].duration.toString() + " s");
   }
 }
 }  // namespace sg
