@@ -11,6 +11,13 @@
 namespace sg {
 namespace {
 
+template <class S>
+Terrain<S> terrainOf(const Scenario::Terrain& t) {
+  Scenario s;
+  s.terrain = t;
+  return Terrain<S>(t, deriveConstants(s));
+}
+
 Scenario::Terrain rampTerrain(int w, int h) {
   Scenario::Terrain t;
   t.flat = false;
@@ -24,7 +31,7 @@ Scenario::Terrain rampTerrain(int w, int h) {
 }
 
 TEST(Terrain, ExactHeightsAtSamplesFx32) {
-  Terrain<Fx32> t(rampTerrain(9, 5));
+  Terrain<Fx32> t = terrainOf<Fx32>(rampTerrain(9, 5));
   // Sample (x, z) sits at ((x - 4) * 0.5, (z - 2) * 0.5): exactly representable.
   for (int z = 0; z < 5; ++z)
     for (int x = 0; x < 9; ++x) {
@@ -35,7 +42,7 @@ TEST(Terrain, ExactHeightsAtSamplesFx32) {
 }
 
 TEST(Terrain, BilinearBetweenSamplesDouble) {
-  Terrain<double> t(rampTerrain(9, 5));
+  Terrain<double> t = terrainOf<double>(rampTerrain(9, 5));
   // The ramp is linear (h = (4x + z) / 50 in sample units): bilinear reproduces it everywhere.
   for (double wx = -1.9; wx < 1.9; wx += 0.173)
     for (double wz = -0.9; wz < 0.9; wz += 0.131) {
@@ -45,8 +52,8 @@ TEST(Terrain, BilinearBetweenSamplesDouble) {
 }
 
 TEST(Terrain, NormalOfAPlane) {
-  Terrain<double> td(rampTerrain(9, 5));
-  Terrain<Fx32> tf(rampTerrain(9, 5));
+  Terrain<double> td = terrainOf<double>(rampTerrain(9, 5));
+  Terrain<Fx32> tf = terrainOf<Fx32>(rampTerrain(9, 5));
   // dh/dx = 4 / 50 / 0.5 = 0.16, dh/dz = 1 / 50 / 0.5 = 0.04.
   const double n = std::sqrt(0.16 * 0.16 + 1 + 0.04 * 0.04);
   double nx, ny, nz;
@@ -63,7 +70,7 @@ TEST(Terrain, NormalOfAPlane) {
 }
 
 TEST(Terrain, EdgeSamplesExtendOutsideTheMap) {
-  Terrain<double> t(rampTerrain(9, 5));
+  Terrain<double> t = terrainOf<double>(rampTerrain(9, 5));
   EXPECT_DOUBLE_EQ(t.heightAt(-100, -100), 0.0);
   EXPECT_NEAR(t.heightAt(100, 100), (4 * 8 + 4) / 50.0, 1e-14);
   EXPECT_NEAR(t.heightAt(-100, 0), 2 / 50.0, 1e-14);
@@ -72,7 +79,7 @@ TEST(Terrain, EdgeSamplesExtendOutsideTheMap) {
 TEST(Terrain, FlatTerrain) {
   Scenario::Terrain flat;
   flat.flatHeight = Rational{3, 2};
-  Terrain<Fx16> t(flat);
+  Terrain<Fx16> t = terrainOf<Fx16>(flat);
   EXPECT_EQ(t.heightAt(Fx16(100), Fx16(-7)), Fx16(3) / Fx16(2));
   Fx16 nx, ny, nz;
   t.normalAt(Fx16(0), Fx16(0), &nx, &ny, &nz);

@@ -11,7 +11,7 @@ namespace {
 // -z for 4 s (240 ticks, starting at tick 660), calm 6 s; period 1260 ticks.
 TEST(WindSchedule, ThesisScheduleInTicks) {
   const Scenario s = test::thesisMeadow();
-  const WindSchedule w = WindSchedule::build(s, 151, Rational{1, 4});
+  const WindSchedule w = WindSchedule::build(s, deriveConstants(s));
   ASSERT_EQ(w.gusts.size(), 4u);
   EXPECT_EQ(w.periodTicks, 1260);
   EXPECT_EQ(w.gusts[0].startTick, 0);
@@ -51,7 +51,7 @@ TEST(WindSchedule, FirstForceTickPerRowForwardTravel) { expectFirstForceTicks(Wi
 
 TEST(WindSchedule, NoForceBeforeArrivalAndRepeatsEveryPeriod) {
   const Scenario s = test::thesisMeadow();
-  const WindSchedule w = WindSchedule::build(s, 151, Rational{1, 4});
+  const WindSchedule w = WindSchedule::build(s, deriveConstants(s));
   EXPECT_FALSE(w.active(0, 100, 199));
   EXPECT_TRUE(w.active(0, 100, 200));
   EXPECT_TRUE(w.active(0, 100, 499));
@@ -63,7 +63,8 @@ TEST(WindSchedule, NoForceBeforeArrivalAndRepeatsEveryPeriod) {
 TEST(WindSchedule, DelaysRoundToNearestTick) {
   Scenario s = test::thesisMeadow();
   s.wind.travelSpeed = Rational{10, 1};  // 0.25 / 10 * 60 = 1.5 ticks per row
-  const WindSchedule w = WindSchedule::build(s, 5, Rational{1, 4});
+  s.field.patchesZ = 5;
+  const WindSchedule w = WindSchedule::build(s, deriveConstants(s));
   EXPECT_EQ(w.delayFromFirstRow, (std::vector<int64_t>{0, 2, 3, 5, 6}));  // 1.5 -> 2, 4.5 -> 5
   EXPECT_EQ(w.delayFromLastRow, (std::vector<int64_t>{6, 5, 3, 2, 0}));
 }

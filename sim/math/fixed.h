@@ -130,18 +130,21 @@ class Fixed {
 
   template <class I>
   static constexpr Raw fromInteger(I value) noexcept {
-    constexpr Raw kMaxInt = std::numeric_limits<Raw>::max() >> Frac;
-    constexpr Raw kMinInt = std::numeric_limits<Raw>::min() >> Frac;
+    // Compared in 128 bits, so every integer type up to __int128 is handled exactly.
+    constexpr __int128 kMaxInt = std::numeric_limits<Raw>::max() >> Frac;
+    constexpr __int128 kMinInt = std::numeric_limits<Raw>::min() >> Frac;
+    bool above, below = false;
     if constexpr (std::is_signed_v<I>) {
-      if (value > I(0) ? uint64_t(value) > uint64_t(kMaxInt) : int64_t(value) < int64_t(kMinInt)) {
-        detail::raiseFixedFault(kFixedFaultOverflow);
-        return value > I(0) ? std::numeric_limits<Raw>::max() : std::numeric_limits<Raw>::min();
-      }
-    } else if (uint64_t(value) > uint64_t(kMaxInt)) {
-      detail::raiseFixedFault(kFixedFaultOverflow);
-      return std::numeric_limits<Raw>::max();
+      above = __int128(value) > kMaxInt;
+      below = __int128(value) < kMinInt;
+    } else {
+      above = static_cast<unsigned __int128>(value) > static_cast<unsigned __int128>(kMaxInt);
     }
-    return static_cast<Raw>(Wide(value) * Wide(kOneRaw));
+    if (above || below) {
+      detail::raiseFixedFault(kFixedFaultOverflow);
+      return above ? std::numeric_limits<Raw>::max() : std::numeric_limits<Raw>::min();
+    }
+    return static_cast<Raw>(__int128(value) * __int128(kOneRaw));
   }
   /// Narrows a wide value to Raw, raising an overflow fault when it does not fit.
   static constexpr Raw narrow(Wide w) noexcept {
@@ -204,13 +207,20 @@ using Fx16 = Fixed<int32_t, int64_t, 16>;
 template <class Raw, class Wide, int Frac>
 Fixed<Raw, Wide, Frac> Fixed<Raw, Wide, Frac>::fromDouble(double v) noexcept {
   const long double scaled = static_cast<long double>(v) * static_cast<long double>(kOneRaw);
-  const long double lim = static_cast<long double>(std::numeric_limits<Raw>::max());
-  if (!(scaled < lim && scaled > -lim)) {
+  if (scaled != scaled) {  // NaN: not representable
+    detail::raiseFixedFault(kFixedFaultOverflow);
+    return Fixed();
+  }
+  // Nearest, ties away from zero (the cast truncates toward zero after adding the half).
+  const long double r = scaled < 0 ? -static_cast<long double>(static_cast<__int128>(-scaled + 0.5L))
+                                   : static_cast<long double>(static_cast<__int128>(scaled + 0.5L));
+  // Raw's extremes are exact in long double (64-bit mantissa): the range ends are accepted.
+  if (!(scaled < 1e38L && scaled > -1e38L) || r > static_cast<long double>(std::numeric_limits<Raw>::max()) ||
+      r < static_cast<long double>(std::numeric_limits<Raw>::min())) {
     detail::raiseFixedFault(kFixedFaultOverflow);
     return v < 0 ? min() : max();
   }
-  const long double r = scaled < 0 ? -(-scaled + 0.5L) : scaled + 0.5L;
-  return fromRaw(static_cast<Raw>(r));  // truncation toward zero after the half: away from zero
+  return fromRaw(static_cast<Raw>(r));
 }
 
 // ---- free functions (found by argument-dependent lookup, also by Eigen) -------------------

@@ -1,7 +1,9 @@
 #include "sim/math/rational.h"
 
 #include <cctype>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace sg {
 namespace {
@@ -9,14 +11,15 @@ using I128 = __int128;
 using U128 = unsigned __int128;
 
 I128 gcd(I128 a, I128 b) {
-  if (a < 0) a = -a;
-  if (b < 0) b = -b;
-  while (b != 0) {
-    const I128 t = a % b;
-    a = b;
-    b = t;
+  // On magnitudes as unsigned: |INT128_MIN| is representable there.
+  U128 x = a < 0 ? U128(0) - U128(a) : U128(a);
+  U128 y = b < 0 ? U128(0) - U128(b) : U128(b);
+  while (y != 0) {
+    const U128 t = x % y;
+    x = y;
+    y = t;
   }
-  return a;
+  return x > U128(~U128(0) >> 1) ? I128(1) : I128(x);  // gcd 2^127 only for (MIN, MIN/0): treat as 1
 }
 
 bool mulChecked(I128 a, I128 b, I128* out) { return !__builtin_mul_overflow(a, b, out); }
@@ -88,7 +91,7 @@ std::optional<Rational> parseDecimal(std::string_view t, std::string* error) {
   if (mant == 0) return Rational{0, 1};
   const int e = exp10 - scale;  // value = mant * 10^e
   if (e > 36 - digits || e < -36) {
-    if (error) *error = "a number between 1e-36 and 1e36 in magnitude";
+    if (error) *error = "a number from 1e-36 to below 1e36 in magnitude";
     return std::nullopt;
   }
   I128 p = 1;
@@ -102,6 +105,8 @@ std::optional<Rational> parseDecimal(std::string_view t, std::string* error) {
 
 std::optional<Rational> Rational::make(I128 num, I128 den) {
   if (den == 0) return std::nullopt;
+  constexpr I128 kMin = std::numeric_limits<I128>::min();
+  if (den < 0 && (num == kMin || den == kMin)) return std::nullopt;
   if (den < 0) {
     num = -num;
     den = -den;
@@ -130,13 +135,17 @@ std::optional<Rational> Rational::parse(std::string_view text, std::string* erro
 }
 
 std::optional<Rational> add(const Rational& a, const Rational& b) {
+  // Over the least common denominator: decimals share powers of ten, which keeps this small.
+  const I128 g = gcd(a.den, b.den);
+  const I128 ad = a.den / g, bd = b.den / g;
   I128 x, y, d, n;
-  if (!mulChecked(a.num, b.den, &x) || !mulChecked(b.num, a.den, &y) ||
-      !mulChecked(a.den, b.den, &d) || __builtin_add_overflow(x, y, &n))
+  if (!mulChecked(a.num, bd, &x) || !mulChecked(b.num, ad, &y) || !mulChecked(a.den, bd, &d) ||
+      __builtin_add_overflow(x, y, &n))
     return std::nullopt;
   return Rational::make(n, d);
 }
 std::optional<Rational> sub(const Rational& a, const Rational& b) {
+  if (b.num == std::numeric_limits<I128>::min()) return std::nullopt;
   return add(a, Rational{-b.num, b.den});
 }
 std::optional<Rational> mul(const Rational& a, const Rational& b) {
@@ -149,7 +158,7 @@ std::optional<Rational> mul(const Rational& a, const Rational& b) {
   return Rational::make(n, d);
 }
 std::optional<Rational> div(const Rational& a, const Rational& b) {
-  if (b.num == 0) return std::nullopt;
+  if (b.num == 0 || b.num == std::numeric_limits<I128>::min()) return std::nullopt;
   return mul(a, Rational{b.den * (b.num < 0 ? -1 : 1), b.num < 0 ? -b.num : b.num});
 }
 int compare(const Rational& a, const Rational& b) {
@@ -173,7 +182,7 @@ std::optional<I128> Rational::toScaledInteger(int fracBits) const {
   const U128 n = neg ? U128(0) - U128(num) : U128(num);
   const U128 d = U128(den);
   U128 q = n / d, r = n % d;
-  if (q >> (126 - fracBits) != 0) return std::nullopt;
+  if (fracBits >= 126 ? q != 0 : (q >> (126 - fracBits)) != 0) return std::nullopt;
   for (int k = 0; k < fracBits; ++k) {
     r <<= 1;  // r < d < 2^127: no overflow
     q <<= 1;
@@ -235,25 +244,40 @@ I128 expNonPositive(I128 x) {
   if (k >= 120) return 0;
   return sum >> int(k);
 }
+
+/// a * b / 2^62 for |a| < 2^70 and 0 <= b < 2^94, without a 256-bit product: b is split in
+/// 32-bit halves so each partial product stays below 2^126 (truncating toward zero).
+I128 mulQ62Wide(I128 a, I128 b) {
+  const I128 hi = b >> 32, lo = b & ((I128(1) << 32) - 1);
+  return (a * hi) / (I128(1) << 30) + (a * lo) / (I128(1) << 62);
+}
+
+int bitLength(I128 v) {
+  int n = 0;
+  for (U128 u = U128(v); u != 0; u >>= 1) ++n;
+  return n;
+}
 }  // namespace
 
 Rational deterministicPow(const Rational& base, const Rational& exponent) {
   // Preconditions are checked by the scenario loader: 0 < base <= 1, exponent >= 0.
-  if (base.num == base.den || exponent.num == 0) return Rational{1, 1};
-  // base = m * 2^-e with m in [1/2, 1): ln(base) = ln(m) - e ln2.
-  I128 q = (base.num << kQ) / base.den;  // base in Q62 (base <= 1, so no overflow)
-  if (q <= 0) return Rational{0, 1};
-  int e = 0;
-  while (q < kOne / 2) {
-    q <<= 1;
-    ++e;
+  if (base.num >= base.den || exponent.num <= 0) return Rational{1, 1};
+  if (base.num <= 0) return Rational{0, 1};
+  // Exact range reduction: base = m * 2^-e with m in [1/2, 1), m computed to 62 bits by exact
+  // long division (so a tiny base or one with 30 digits keeps its full precision).
+  int e = std::max(0, bitLength(base.den) - bitLength(base.num) - 1);
+  I128 m = 0;
+  for (int tries = 0; tries < 4; ++tries) {
+    m = *base.toScaledInteger(kQ + e);  // base * 2^(62 + e) < 2^63: always fits
+    if (m < kOne / 2) ++e;
+    else if (m >= kOne) --e;
+    else break;
   }
-  const I128 lnBase = lnReduced(q) - I128(e) * ln2();  // <= 0, |lnBase| < 2^69
-  // x = exponent * ln(base), computed as (lnBase * num) / den with a 128-bit guard.
-  I128 prod;
-  if (__builtin_mul_overflow(lnBase, exponent.num, &prod)) return Rational{0, 1};
-  const I128 x = prod / exponent.den;
-  const I128 result = expNonPositive(x);
-  return *Rational::make(result, kOne);
+  const I128 lnBase = lnReduced(m) - I128(e) * ln2();  // <= 0, |lnBase| < 2^70
+  // x = exponent * ln(base); an exponent beyond 2^30 drives any base < 1 to 0.
+  const auto scaledExponent = exponent.toScaledInteger(kQ);
+  if (!scaledExponent || *scaledExponent >= (I128(1) << 92)) return Rational{0, 1};
+  const I128 x = -mulQ62Wide(-lnBase, *scaledExponent);
+  return *Rational::make(expNonPositive(x), kOne);
 }
 }  // namespace sg

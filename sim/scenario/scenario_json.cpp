@@ -112,7 +112,9 @@ class Reader {
     throw ScenarioError(file_, path, expected);
   }
   [[noreturn]] void failGot(const std::string& path, const std::string& expected, const json& got) const {
-    fail(path, expected + ", got " + show(got));
+    // Show a number as the user wrote it, not as the double it parsed to.
+    const auto raw = got.is_number_float() ? raw_.find(path) : raw_.end();
+    fail(path, expected + ", got " + (raw != raw_.end() ? raw->second : show(got)));
   }
 
   /// Checks that j is an object whose keys are all in `allowed`.
@@ -143,7 +145,7 @@ class Reader {
     }
     std::string why;
     auto r = Rational::parse(text, &why);
-    if (!r) fail(path, why + ", got " + show(j));
+    if (!r) fail(path, why + ", got " + text);
     return *r;
   }
   Rational positive(const json& j, const std::string& path) const {
@@ -334,7 +336,7 @@ Scenario parseScenario(const std::string& text, const std::string& sourceName, c
   const bool wellFormed = json::sax_parse(text, &collector);
   if (!wellFormed && collector.numberOverflow)
     throw ScenarioError(sourceName, collector.errorPath,
-                        "a number between 1e-36 and 1e36 in magnitude, got " + collector.errorToken);
+                        "a number from 1e-36 to below 1e36 in magnitude, got " + collector.errorToken);
   json root;
   try {
     root = json::parse(text);

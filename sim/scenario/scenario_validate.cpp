@@ -2,7 +2,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "sim/scenario/scenario.h"
+#include "sim/scenario/derived.h"
 
 namespace sg {
 namespace {
@@ -22,14 +22,15 @@ void checkResolution(const Scenario& s) {
     auto v = T::fromRational(r);
     if (!v || *v == S(0))
       throw ScenarioError(s.sourceName, path,
-                          std::string(what) + " that is non-zero in " + scalarName(T::kind) + ", got " + r.toString());
+                          std::string(what) + " that does not round to zero in " + scalarName(T::kind) + ", got " +
+                              r.toString());
   };
   nonZero(s.timeStep, "$.timeStep", "a time step");
   nonZero(s.field.spacing, "$.field.spacing", "a spacing");
   nonZero(s.particles.constraintLength, "$.particles.constraintLength", "a constraint length");
   nonZero(s.wind.travelSpeed, "$.wind.travelSpeed", "a travel speed");
   auto perTick = deterministicPow(s.particles.damping, s.timeStep);
-  nonZero(perTick, "$.particles.damping", "a damping whose per-tick factor damping^dt is");
+  nonZero(perTick, "$.particles.damping", "a damping whose per-tick factor damping^dt stays a value");
 }
 }  // namespace
 
@@ -53,6 +54,8 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
       << double(bytes) / (1 << 30) << " GiB, the limit is " << double(memoryLimitBytes) / (1 << 30) << " GiB";
     throw ScenarioError(s.sourceName, "$.field", o.str());
   }
+  // Every exact constant the world will use (throws with a path if one cannot be formed).
+  const ScenarioConstants derived = deriveConstants(s);
   // Coordinates: every position the world can produce must fit the scalar's safe range.
   dispatchScalar(scalar, [&]<class S>() {
     const double limit = ScalarTraits<S>::maxCoordinate;
@@ -99,34 +102,29 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
     }
     fits(pa.constraintLength, "$.particles.constraintLength");
     fits(pa.mass, "$.particles.mass");
-    fits(*div(Rational{1, 1}, pa.mass), "$.particles.mass");
-    fits(*div(Rational{1, 1}, s.timeStep), "$.timeStep");
+    fits(derived.invMass, "$.particles.mass");
+    fits(derived.invDt, "$.timeStep");
+    fits(derived.halfRod, "$.particles.constraintLength");
+    fits(derived.jitterAmplitude, "$.field.jitter");
+    fits(derived.fieldOriginX, "$.field.center[0]");
+    fits(derived.fieldOriginZ, "$.field.center[1]");
     fits(s.field.scaleY, "$.field.scaleY");
     fits(s.field.scaleXZ, "$.field.scaleXZ");
     fits(s.field.spacing, "$.field.spacing");
     fits(s.wind.travelSpeed, "$.wind.travelSpeed");
-    for (size_t i = 0; i < s.wind.schedule.size(); ++i)
-      for (int c = 0; c < 3; ++c) {
-        auto perMass = div(s.wind.schedule[i].force[size_t(c)], pa.mass);
-        const std::string path = "$.wind.schedule[" + std::to_string(i) + "].force[" + std::to_string(c) + "]";
-        if (!perMass) throw ScenarioError(s.sourceName, path, "a force of representable size");
-        fits(*perMass, path);
-      }
+    fits(s.terrain.flatHeight, "$.terrain.height");
+    for (size_t i = 0; i < derived.gustForcePerMass.size(); ++i)
+      for (int c = 0; c < 3; ++c)
+        fits(derived.gustForcePerMass[i][size_t(c)],
+             "$.wind.schedule[" + std::to_string(i) + "].force[" + std::to_string(c) + "]");
     if (!s.terrain.flat) {
       fits(s.terrain.cellSize, "$.terrain.cellSize");
-      fits(*div(Rational{1, 1}, s.terrain.cellSize), "$.terrain.cellSize");
+      fits(derived.terrainInvCellSize, "$.terrain.cellSize");
+      fits(derived.terrainOriginX, "$.terrain.center[0]");
+      fits(derived.terrainOriginZ, "$.terrain.center[1]");
+      fits(s.terrain.maxHeight, "$.terrain.maxHeight");
     }
     checkResolution<S>(s);
   });
-  // Every gust lasts at least one tick (a shorter one would be lengthened silently), and its
-  // length in ticks is the duration rounded to the nearest tick.
-  for (size_t i = 0; i < s.wind.schedule.size(); ++i) {
-    auto ticks = div(s.wind.schedule[i].duration, s.timeStep);
-    auto n = ticks ? ticks->roundToInt64() : std::nullopt;
-    if (!n || compare(s.wind.schedule[i].duration, s.timeStep) < 0 || *n > (int64_t(1) << 40))
-      throw ScenarioError(s.sourceName, "$.wind.schedule[" + std::to_string(i) + "].duration",
-                          "a duration of at least one time step (" + s.timeStep.toString() + " s), got " +
-                              s.wind.schedule[i].duration.toString() + " s");
-  }
 }
 }  // namespace sg

@@ -4,6 +4,13 @@
 
 #include <cstring>
 
+namespace {
+std::string reason() {
+  const char* r = stbi_failure_reason();
+  return r && *r ? r : "corrupt or truncated";
+}
+}  // namespace
+
 namespace sg {
 bool decodeHeightmapPng(std::span<const uint8_t> bytes, Heightmap* out, std::string* error) {
   static const uint8_t kPngMagic[8] = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
@@ -19,7 +26,7 @@ bool decodeHeightmapPng(std::span<const uint8_t> bytes, Heightmap* out, std::str
   const int len = int(bytes.size());
   int w = 0, h = 0, channels = 0;
   if (!stbi_info_from_memory(data, len, &w, &h, &channels)) {
-    *error = std::string("a readable PNG (") + stbi_failure_reason() + ")";
+    *error = "a readable PNG (" + reason() + ")";
     return false;
   }
   if (stbi_is_16_bit_from_memory(data, len)) {
@@ -37,7 +44,7 @@ bool decodeHeightmapPng(std::span<const uint8_t> bytes, Heightmap* out, std::str
   }
   stbi_uc* pixels = stbi_load_from_memory(data, len, &w, &h, &channels, 1);
   if (!pixels) {
-    *error = std::string("a readable PNG (") + stbi_failure_reason() + ")";
+    *error = "a readable PNG (" + reason() + ")";
     return false;
   }
   out->width = w;

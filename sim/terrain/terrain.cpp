@@ -9,17 +9,17 @@ S exact(const Rational& r) {
 }  // namespace
 
 template <class S>
-Terrain<S>::Terrain(const Scenario::Terrain& t) : flat_(t.flat), flatHeight_(exact<S>(t.flatHeight)) {
+Terrain<S>::Terrain(const Scenario::Terrain& t, const ScenarioConstants& c)
+    : flat_(t.flat), flatHeight_(exact<S>(t.flatHeight)) {
   if (flat_) return;
   width_ = t.heightmap.width;
   depth_ = t.heightmap.height;
   cellSize_ = exact<S>(t.cellSize);
-  invCellSize_ = exact<S>(*div(Rational{1, 1}, t.cellSize));
-  // Sample (0, 0) sits at centre - cellSize * (n - 1) / 2.
-  originX_ = exact<S>(*sub(t.centerX, *mul(t.cellSize, Rational{width_ - 1, 2})));
-  originZ_ = exact<S>(*sub(t.centerZ, *mul(t.cellSize, Rational{depth_ - 1, 2})));
+  invCellSize_ = exact<S>(c.terrainInvCellSize);
+  originX_ = exact<S>(c.terrainOriginX);  // sample (0, 0) sits at centre - cellSize * (n - 1) / 2
+  originZ_ = exact<S>(c.terrainOriginZ);
   S table[256];
-  for (int v = 0; v < 256; ++v) table[v] = exact<S>(*mul(t.maxHeight, *Rational::make(v, 255)));
+  for (int v = 0; v < 256; ++v) table[v] = exact<S>(c.terrainHeightOfSample[size_t(v)]);
   heights_.resize(t.heightmap.samples.size());
   for (size_t i = 0; i < heights_.size(); ++i) heights_[i] = table[t.heightmap.samples[i]];
 }

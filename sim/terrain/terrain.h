@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "sim/math/scalar_ops.h"
-#include "sim/scenario/scenario.h"
+#include "sim/scenario/derived.h"
 
 namespace sg {
 
@@ -15,7 +15,7 @@ template <class S>
 class Terrain {
  public:
   Terrain() = default;
-  explicit Terrain(const Scenario::Terrain& t);
+  Terrain(const Scenario::Terrain& t, const ScenarioConstants& c);
 
   bool flat() const { return flat_; }
   /// Height (m) at world (x, z).

@@ -2,24 +2,19 @@
 
 namespace sg {
 
-WindSchedule WindSchedule::build(const Scenario& s, int64_t rows, const Rational& rowSpacing) {
+WindSchedule WindSchedule::build(const Scenario& s, const ScenarioConstants& c) {
   WindSchedule w;
   int64_t offset = 0;
-  for (const WindGust& g : s.wind.schedule) {
-    const int64_t duration = *div(g.duration, s.timeStep)->roundToInt64();  // validated >= 1
-    const bool backward = s.wind.travel == WindTravel::Direction && g.force[2].num < 0;
-    w.gusts.push_back({offset, duration, backward});
-    offset += duration;
+  for (size_t g = 0; g < s.wind.schedule.size(); ++g) {
+    const bool backward = s.wind.travel == WindTravel::Direction && s.wind.schedule[g].force[2].num < 0;
+    w.gusts.push_back({offset, c.gustTicks[g], backward});
+    offset += c.gustTicks[g];
   }
   w.periodTicks = offset > 0 ? offset : 1;
-  // Ticks per row step = rowSpacing / (speed * dt), kept exact; round once per row.
-  const Rational ticksPerRow = *div(rowSpacing, *mul(s.wind.travelSpeed, s.timeStep));
-  w.delayFromFirstRow.resize(size_t(rows));
-  w.delayFromLastRow.resize(size_t(rows));
-  for (int64_t r = 0; r < rows; ++r) {
-    w.delayFromFirstRow[size_t(r)] = *mul(ticksPerRow, Rational::integer(r))->roundToInt64();
-    w.delayFromLastRow[size_t(r)] = *mul(ticksPerRow, Rational::integer(rows - 1 - r))->roundToInt64();
-  }
+  const size_t rows = c.rowDelayTicks.size();
+  w.delayFromFirstRow = c.rowDelayTicks;
+  w.delayFromLastRow.resize(rows);
+  for (size_t r = 0; r < rows; ++r) w.delayFromLastRow[r] = c.rowDelayTicks[rows - 1 - r];
   return w;
 }
 

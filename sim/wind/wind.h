@@ -12,7 +12,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "sim/scenario/scenario.h"
+#include "sim/scenario/derived.h"
 
 namespace sg {
 
@@ -27,8 +27,8 @@ struct WindSchedule {
   std::vector<int64_t> delayFromFirstRow;  ///< d(r) for rows counted from row 0
   std::vector<int64_t> delayFromLastRow;   ///< d(r) for rows counted from the last row
 
-  /// Builds the tick schedule for `rows` particle rows spaced `rowSpacing` metres apart.
-  static WindSchedule build(const Scenario& s, int64_t rows, const Rational& rowSpacing);
+  /// Builds the tick schedule from the scenario's derived constants (gust ticks, row delays).
+  static WindSchedule build(const Scenario& s, const ScenarioConstants& c);
 
   /// Is gust g blowing on particle row `row` during tick `tick`?
   bool active(size_t g, int64_t row, int64_t tick) const {

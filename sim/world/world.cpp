@@ -21,9 +21,11 @@ constexpr int64_t kTargetChunkElements = 4096;  // chunk size: fixed by problem 
 
 template <class S>
 S toS(const Rational& r) {
-  return *ScalarTraits<S>::fromRational(r);  // ranges checked by validateForScalar
+  // validateForScalar checks every value first; this guard turns a missed case into an error.
+  const auto v = ScalarTraits<S>::fromRational(r);
+  if (!v) throw std::out_of_range(std::string("value ") + r.toString() + " does not fit " + scalarName(ScalarTraits<S>::kind));
+  return *v;
 }
-Rational R(std::optional<Rational> r) { return *r; }  // scenario arithmetic on validated values
 
 void hashRational(HashSink& h, const Rational& r) {
   h.write(&r.num, sizeof r.num);
@@ -76,46 +78,46 @@ template <class S>
 World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPool>(threads < 1 ? 1 : threads)) {
   configHash_ = scenarioFingerprint(s);
   constraintMode_ = s.particles.constraintMode;
+  const ScenarioConstants c = deriveConstants(s);
   const auto& f = s.field;
   const int k = s.particles.interpolation;
 
   lattice_.patchesX = f.patchesX;
   lattice_.patchesZ = f.patchesZ;
   lattice_.spacing = toS<S>(f.spacing);
-  lattice_.jitterAmplitude = toS<S>(R(mul(f.jitter, f.spacing)));
-  lattice_.originX = toS<S>(R(sub(f.centerX, R(mul(f.spacing, Rational{f.patchesX - 1, 2})))));
-  lattice_.originZ = toS<S>(R(sub(f.centerZ, R(mul(f.spacing, Rational{f.patchesZ - 1, 2})))));
+  lattice_.jitterAmplitude = toS<S>(c.jitterAmplitude);
+  lattice_.originX = toS<S>(c.fieldOriginX);
+  lattice_.originZ = toS<S>(c.fieldOriginZ);
   lattice_.seed = s.seed;
   lattice_.atlasVariants = f.atlasVariants;
-  terrain_ = Terrain<S>(s.terrain);
+  terrain_ = Terrain<S>(s.terrain, c);
 
   grid_.k = k;
-  grid_.countX = ParticleGrid::coverCount(f.patchesX, k);
-  grid_.countZ = ParticleGrid::coverCount(f.patchesZ, k);
+  grid_.countX = c.particlesX;
+  grid_.countZ = c.particlesZ;
 
   particleConsts_.dt = toS<S>(s.timeStep);
-  particleConsts_.invDt = toS<S>(R(div(Rational{1, 1}, s.timeStep)));
-  particleConsts_.dampingPerTick = toS<S>(deterministicPow(s.particles.damping, s.timeStep));
+  particleConsts_.invDt = toS<S>(c.invDt);
+  particleConsts_.dampingPerTick = toS<S>(c.dampingPerTick);
   particleConsts_.rodLength = toS<S>(s.particles.constraintLength);
 
   patchConsts_.k = k;
-  for (int t = 0; t < k; ++t) patchConsts_.weight.push_back(toS<S>(Rational{t, k}));
+  for (const Rational& w : c.interpolationWeights) patchConsts_.weight.push_back(toS<S>(w));
   patchConsts_.rodLength = particleConsts_.rodLength;
-  patchConsts_.halfRod = toS<S>(R(mul(s.particles.constraintLength, Rational{1, 2})));
+  patchConsts_.halfRod = toS<S>(c.halfRod);
   patchConsts_.scaleY = toS<S>(f.scaleY);
   for (int i = 0; i < 3; ++i) patchConsts_.drop[i] = toS<S>(s.particles.tiltDrop[size_t(i)]);
 
-  const Rational invMass = R(div(Rational{1, 1}, s.particles.mass));
-  for (const WindGust& g : s.wind.schedule) {
-    windConsts_.forceX.push_back(toS<S>(R(mul(g.force[0], invMass))));
-    windConsts_.forceY.push_back(toS<S>(R(mul(g.force[1], invMass))));
-    windConsts_.forceZ.push_back(toS<S>(R(mul(g.force[2], invMass))));
+  for (const auto& force : c.gustForcePerMass) {
+    windConsts_.forceX.push_back(toS<S>(force[0]));
+    windConsts_.forceY.push_back(toS<S>(force[1]));
+    windConsts_.forceZ.push_back(toS<S>(force[2]));
   }
   windConsts_.accX = toS<S>(s.particles.acceleration[0]);
   windConsts_.accY = toS<S>(s.particles.acceleration[1]);
   windConsts_.accZ = toS<S>(s.particles.acceleration[2]);
   windConsts_.dt = particleConsts_.dt;
-  windSchedule_ = WindSchedule::build(s, grid_.countZ, R(mul(f.spacing, Rational::integer(k))));
+  windSchedule_ = WindSchedule::build(s, c);
 
   // Patches: static attributes from the lattice hash, roots on the terrain.
   const size_t nPatches = size_t(f.patchesX * f.patchesZ);

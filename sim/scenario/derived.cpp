@@ -1,0 +1,77 @@
+#include "sim/scenario/derived.h"
+
+namespace sg {
+namespace {
+/// Unwraps a checked result or reports the path whose value made the arithmetic overflow.
+class Checked {
+ public:
+  explicit Checked(const Scenario& s) : s_(s) {}
+  Rational operator()(std::optional<Rational> r, const std::string& path) const {
+    if (!r)
+      throw ScenarioError(s_.sourceName, path,
+                          "a value that combines exactly with the others in 128-bit fractions "
+                          "(write it with fewer significant digits)");
+    return *r;
+  }
+  int64_t ticks(std::optional<Rational> r, const std::string& path) const {
+    auto n = (*this)(r, path).roundToInt64();
+    if (!n || *n > (int64_t(1) << 40))
+      throw ScenarioError(s_.sourceName, path, "a duration below 2^40 ticks");
+    return *n;
+  }
+ private:
+  const Scenario& s_;
+};
+}  // namespace
+
+ScenarioConstants deriveConstants(const Scenario& s) {
+  const Checked ok(s);
+  ScenarioConstants c;
+  const auto& f = s.field;
+  const auto& p = s.particles;
+  const int k = p.interpolation;
+  c.invDt = ok(div(Rational{1, 1}, s.timeStep), "$.timeStep");
+  c.dampingPerTick = deterministicPow(p.damping, s.timeStep);
+  c.halfRod = ok(mul(p.constraintLength, Rational{1, 2}), "$.particles.constraintLength");
+  c.invMass = ok(div(Rational{1, 1}, p.mass), "$.particles.mass");
+  c.jitterAmplitude = ok(mul(f.jitter, f.spacing), "$.field.jitter");
+  c.fieldOriginX = ok(sub(f.centerX, ok(mul(f.spacing, Rational{f.patchesX - 1, 2}), "$.field.spacing")), "$.field.center[0]");
+  c.fieldOriginZ = ok(sub(f.centerZ, ok(mul(f.spacing, Rational{f.patchesZ - 1, 2}), "$.field.spacing")), "$.field.center[1]");
+  c.particlesX = (f.patchesX - 1 + k - 1) / k + 1;
+  c.particlesZ = (f.patchesZ - 1 + k - 1) / k + 1;
+  for (int t = 0; t < k; ++t) c.interpolationWeights.push_back(Rational{t, k});
+
+  for (size_t g = 0; g < s.wind.schedule.size(); ++g) {
+    const std::string path = "$.wind.schedule[" + std::to_string(g) + "]";
+    std::array<Rational, 3> perMass;
+    for (int i = 0; i < 3; ++i)
+      perMass[size_t(i)] = ok(mul(s.wind.schedule[g].force[size_t(i)], c.invMass), path + ".force[" + std::to_string(i) + "]");
+    c.gustForcePerMass.push_back(perMass);
+    const Rational& duration = s.wind.schedule[g].duration;
+    if (compare(duration, s.timeStep) < 0)
+      throw ScenarioError(s.sourceName, path + ".duration",
+                          "a duration of at least one time step (" + s.timeStep.toString() + " s), got " +
+                              duration.toString() + " s");
+    c.gustTicks.push_back(ok.ticks(div(duration, s.timeStep), path + ".duration"));
+  }
+  // A gust front needs rowSpacing / (speed * dt) ticks per particle row.
+  const Rational rowSpacing = ok(mul(f.spacing, Rational::integer(k)), "$.field.spacing");
+  const Rational ticksPerRow =
+      ok(div(rowSpacing, ok(mul(s.wind.travelSpeed, s.timeStep), "$.wind.travelSpeed")), "$.wind.travelSpeed");
+  c.rowDelayTicks.resize(size_t(c.particlesZ));
+  for (int64_t r = 0; r < c.particlesZ; ++r)
+    c.rowDelayTicks[size_t(r)] = ok.ticks(mul(ticksPerRow, Rational::integer(r)), "$.wind.travelSpeed");
+
+  if (!s.terrain.flat) {
+    const auto& t = s.terrain;
+    c.terrainInvCellSize = ok(div(Rational{1, 1}, t.cellSize), "$.terrain.cellSize");
+    c.terrainOriginX = ok(sub(t.centerX, ok(mul(t.cellSize, Rational{t.heightmap.width - 1, 2}), "$.terrain.cellSize")),
+                          "$.terrain.center[0]");
+    c.terrainOriginZ = ok(sub(t.centerZ, ok(mul(t.cellSize, Rational{t.heightmap.height - 1, 2}), "$.terrain.cellSize")),
+                          "$.terrain.center[1]");
+    for (int v = 0; v < 256; ++v)
+      c.terrainHeightOfSample[size_t(v)] = ok(mul(t.maxHeight, *Rational::make(v, 255)), "$.terrain.maxHeight");
+  }
+  return c;
+}
+}  // namespace sg
