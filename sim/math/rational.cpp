@@ -245,11 +245,14 @@ I128 expNonPositive(I128 x) {
   return sum >> int(k);
 }
 
-/// a * b / 2^62 for |a| < 2^70 and 0 <= b < 2^94, without a 256-bit product: b is split in
-/// 32-bit halves so each partial product stays below 2^126 (truncating toward zero).
-I128 mulQ62Wide(I128 a, I128 b) {
+/// a * b / 2^62 for a, b >= 0 without a 256-bit product: b is split in 32-bit halves. Returns
+/// false when the result exceeds 2^97 (then exp(-result) is 0 in Q62 anyway).
+bool mulQ62Wide(I128 a, I128 b, I128* out) {
   const I128 hi = b >> 32, lo = b & ((I128(1) << 32) - 1);
-  return (a * hi) / (I128(1) << 30) + (a * lo) / (I128(1) << 62);
+  I128 ph, pl;
+  if (__builtin_mul_overflow(a, hi, &ph) || __builtin_mul_overflow(a, lo, &pl)) return false;
+  *out = ph / (I128(1) << 30) + pl / (I128(1) << 62);
+  return true;
 }
 
 int bitLength(I128 v) {
@@ -274,10 +277,10 @@ Rational deterministicPow(const Rational& base, const Rational& exponent) {
     else break;
   }
   const I128 lnBase = lnReduced(m) - I128(e) * ln2();  // <= 0, |lnBase| < 2^70
-  // x = exponent * ln(base); an exponent beyond 2^30 drives any base < 1 to 0.
+  // x = exponent * ln(base). An x too large for 128 bits means base^exponent < 2^-(2^35): 0.
   const auto scaledExponent = exponent.toScaledInteger(kQ);
-  if (!scaledExponent || *scaledExponent >= (I128(1) << 92)) return Rational{0, 1};
-  const I128 x = -mulQ62Wide(-lnBase, *scaledExponent);
-  return *Rational::make(expNonPositive(x), kOne);
+  I128 magnitude;
+  if (!scaledExponent || !mulQ62Wide(-lnBase, *scaledExponent, &magnitude)) return Rational{0, 1};
+  return *Rational::make(expNonPositive(-magnitude), kOne);
 }
 }  // namespace sg
