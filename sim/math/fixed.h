@@ -45,7 +45,8 @@ inline uint32_t takeFixedFaults() noexcept {
 /// Human-readable name of the most significant fault bit ("overflow", ...).
 const char* fixedFaultName(uint32_t faults) noexcept;
 
-/// Integer square roots, exact: floor variant and round-to-nearest variant.
+/// Integer square roots, exact: floor variant and round-to-nearest variant. isqrtNearest needs
+/// n <= 2^128 - 2^64 (its result must fit 64 bits); sqrt and length3 stay far below that.
 uint64_t isqrtFloor(unsigned __int128 n) noexcept;
 inline uint64_t isqrtNearest(unsigned __int128 n) noexcept {
   const uint64_t r = isqrtFloor(n);
@@ -211,12 +212,15 @@ Fixed<Raw, Wide, Frac> Fixed<Raw, Wide, Frac>::fromDouble(double v) noexcept {
     detail::raiseFixedFault(kFixedFaultOverflow);
     return Fixed();
   }
+  // Guard the float -> integer conversion first (converting an out-of-range value is UB), then
+  // round in 128 bits and compare that integer exactly with the format's limits.
+  if (!(scaled > -1e37L && scaled < 1e37L)) {
+    detail::raiseFixedFault(kFixedFaultOverflow);
+    return v < 0 ? min() : max();
+  }
   // Nearest, ties away from zero (the cast truncates toward zero after adding the half).
-  const long double r = scaled < 0 ? -static_cast<long double>(static_cast<__int128>(-scaled + 0.5L))
-                                   : static_cast<long double>(static_cast<__int128>(scaled + 0.5L));
-  // Raw's extremes are exact in long double (64-bit mantissa): the range ends are accepted.
-  if (!(scaled < 1e38L && scaled > -1e38L) || r > static_cast<long double>(std::numeric_limits<Raw>::max()) ||
-      r < static_cast<long double>(std::numeric_limits<Raw>::min())) {
+  const __int128 r = scaled < 0 ? -static_cast<__int128>(-scaled + 0.5L) : static_cast<__int128>(scaled + 0.5L);
+  if (r > __int128(std::numeric_limits<Raw>::max()) || r < __int128(std::numeric_limits<Raw>::min())) {
     detail::raiseFixedFault(kFixedFaultOverflow);
     return v < 0 ? min() : max();
   }

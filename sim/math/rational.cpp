@@ -36,14 +36,20 @@ std::string toDecimalString(I128 v) {
   return neg ? "-" + s : s;
 }
 
-// Parses a plain decimal number token: -?digits[.digits][e[+-]digits].
+// Parses a plain decimal number token: -?digits[.digits][e[+-]digits]. Leading and trailing
+// zeros are not significant digits ("1.000" and "0.5" have one).
 std::optional<Rational> parseDecimal(std::string_view t, std::string* error) {
   constexpr int kMaxDigits = 30;  // keeps num and 10^k well inside 128 bits
+  auto fail = [&](const char* what) {
+    if (error) *error = what;
+    return std::optional<Rational>();
+  };
   size_t i = 0;
   bool neg = false;
   if (i < t.size() && (t[i] == '-' || t[i] == '+')) neg = t[i++] == '-';
   I128 mant = 0;
-  int digits = 0, scale = 0;  // value = mant * 10^(-scale)
+  int digits = 0, scale = 0;           // value = mant * 10^(-scale) * 10^pendingInt
+  int pendingInt = 0, pendingFrac = 0; // zeros seen after the last non-zero digit
   bool any = false, dot = false;
   for (; i < t.size(); ++i) {
     const char c = t[i];
@@ -53,21 +59,23 @@ std::optional<Rational> parseDecimal(std::string_view t, std::string* error) {
     }
     if (!std::isdigit(static_cast<unsigned char>(c))) break;
     any = true;
-    if (mant == 0 && c == '0') {
-      if (dot) ++scale;  // leading zeros after the point only shift the scale
+    if (c == '0') {
+      if (mant == 0) {
+        if (dot) ++scale;  // leading zeros after the point only shift the scale
+      } else {
+        ++(dot ? pendingFrac : pendingInt);
+      }
       continue;
     }
-    if (++digits > kMaxDigits) {
-      if (error) *error = "a number with at most 30 significant digits";
-      return std::nullopt;
-    }
+    // A non-zero digit makes the zeros before it significant.
+    digits += pendingInt + pendingFrac + 1;
+    if (digits > kMaxDigits) return fail("a number with at most 30 significant digits");
+    for (int z = 0; z < pendingInt + pendingFrac; ++z) mant *= 10;
+    scale += pendingFrac + (dot ? 1 : 0);
+    pendingInt = pendingFrac = 0;
     mant = mant * 10 + (c - '0');
-    if (dot) ++scale;
   }
-  if (!any) {
-    if (error) *error = "a number";
-    return std::nullopt;
-  }
+  if (!any) return fail("a number");
   int exp10 = 0;
   if (i < t.size() && (t[i] == 'e' || t[i] == 'E')) {
     ++i;
@@ -78,22 +86,15 @@ std::optional<Rational> parseDecimal(std::string_view t, std::string* error) {
       edig = true;
       if (exp10 < 10000) exp10 = exp10 * 10 + (t[i] - '0');
     }
-    if (!edig) {
-      if (error) *error = "a number (exponent digits after 'e')";
-      return std::nullopt;
-    }
+    if (!edig) return fail("a number (exponent digits after 'e')");
     if (eneg) exp10 = -exp10;
   }
-  if (i != t.size()) {
-    if (error) *error = "a number";
-    return std::nullopt;
-  }
+  if (i != t.size()) return fail("a number");
   if (mant == 0) return Rational{0, 1};
-  const int e = exp10 - scale;  // value = mant * 10^e
-  if (e > 36 - digits || e < -36) {
-    if (error) *error = "a number from 1e-36 to below 1e36 in magnitude";
-    return std::nullopt;
-  }
+  // value = mant * 10^e with mant of `digits` digits: 10^(digits-1+e) <= |value| < 10^(digits+e).
+  const int e = exp10 - scale + pendingInt;
+  if (digits + e > 36 || digits - 1 + e < -36) return fail("a number from 1e-36 to below 1e36 in magnitude");
+  if (e < -38) return fail("a number with at most 38 decimal places");
   I128 p = 1;
   for (int k = 0; k < (e < 0 ? -e : e); ++k) p *= 10;
   const I128 n = neg ? -mant : mant;
