@@ -33,9 +33,15 @@ std::unique_ptr<SimWorld> build(const GoldenCase& c, int threads) {
   return makeWorld(s, threads);
 }
 
-void runTicks(SimWorld& w, int64_t ticks) {
-  const TickInput input;
-  for (int64_t t = 0; t < ticks; ++t) ASSERT_TRUE(w.step(input).ok) << "tick " << w.tick();
+Scenario scenarioOf(const GoldenCase& c) {
+  Scenario s = loadScenarioFile(test::sourcePath("scenarios/" + c.scenario + ".json"));
+  s.scalar = *parseScalarKind(c.scalar);
+  return s;
+}
+
+/// Runs with the scenario's scripted inputs (empty for scenarios without a script).
+void runTicks(SimWorld& w, int64_t ticks, const Scenario& s = test::thesisMeadow()) {
+  for (int64_t t = 0; t < ticks; ++t) ASSERT_TRUE(w.step(scriptedInput(s, w.tick())).ok) << "tick " << w.tick();
 }
 
 class GoldenHash : public ::testing::TestWithParam<std::tuple<GoldenCase, int>> {};
@@ -45,7 +51,7 @@ TEST_P(GoldenHash, MatchesCommittedHashAfter600Ticks) {
   const nlohmann::json g = goldens();
   const std::string expected = g.at(c.scenario + "/" + c.scalar);
   auto w = build(c, threads);
-  runTicks(*w, g.at("ticks").get<int64_t>());
+  runTicks(*w, g.at("ticks").get<int64_t>(), scenarioOf(c));
   EXPECT_EQ(hex(w->stateHash()), expected)
       << c.scenario << " " << c.scalar << " with " << threads
       << " threads. If the physics was meant to change, run .ci/update-goldens and say why in the commit.";
@@ -54,7 +60,8 @@ TEST_P(GoldenHash, MatchesCommittedHashAfter600Ticks) {
 INSTANTIATE_TEST_SUITE_P(
     ScenariosScalarsThreads, GoldenHash,
     ::testing::Combine(::testing::Values(GoldenCase{"thesis-meadow", "fx32"}, GoldenCase{"thesis-meadow", "fx16"},
-                                         GoldenCase{"hilly-meadow", "fx32"}, GoldenCase{"hilly-meadow", "fx16"}),
+                                         GoldenCase{"hilly-meadow", "fx32"}, GoldenCase{"hilly-meadow", "fx16"},
+                                         GoldenCase{"thesis-bodies", "fx32"}, GoldenCase{"thesis-bodies", "fx16"}),
                        ::testing::Values(1, 2, 4)),
     [](const auto& info) {
       const GoldenCase& c = std::get<0>(info.param);
@@ -69,7 +76,7 @@ TEST_P(SaveRestore, RestoreAtTick300ContinuesToTheGoldenHash) {
   const GoldenCase c = GetParam();
   const nlohmann::json g = goldens();
   auto first = build(c, 2);
-  runTicks(*first, 300);
+  runTicks(*first, 300, scenarioOf(c));
   const std::vector<uint8_t> saved = first->saveState();
   EXPECT_EQ(XXH3_64bits(saved.data(), saved.size()), first->stateHash()) << "hash is over the saved bytes";
 
@@ -77,13 +84,14 @@ TEST_P(SaveRestore, RestoreAtTick300ContinuesToTheGoldenHash) {
   fresh->restoreState(saved);
   EXPECT_EQ(fresh->tick(), 300);
   EXPECT_EQ(fresh->stateHash(), first->stateHash());
-  runTicks(*fresh, 300);
+  runTicks(*fresh, 300, scenarioOf(c));
   EXPECT_EQ(hex(fresh->stateHash()), g.at(c.scenario + "/" + c.scalar).get<std::string>());
 }
 
 INSTANTIATE_TEST_SUITE_P(Goldens, SaveRestore,
                          ::testing::Values(GoldenCase{"thesis-meadow", "fx32"}, GoldenCase{"thesis-meadow", "fx16"},
-                                           GoldenCase{"hilly-meadow", "fx32"}, GoldenCase{"hilly-meadow", "fx16"}),
+                                           GoldenCase{"hilly-meadow", "fx32"}, GoldenCase{"hilly-meadow", "fx16"},
+                                           GoldenCase{"thesis-bodies", "fx32"}, GoldenCase{"thesis-bodies", "fx16"}),
                          [](const auto& info) {
                            std::string n = info.param.scenario + "_" + info.param.scalar;
                            for (char& ch : n) if (ch == '-') ch = '_';

@@ -9,12 +9,7 @@
 namespace sg {
 namespace {
 
-template <class S>
-std::unique_ptr<World<S>> makeTyped(Scenario s) {
-  s.scalar = ScalarTraits<S>::kind;
-  validateForScalar(s, s.scalar, 0);
-  return std::make_unique<World<S>>(s, 1);
-}
+using test::makeTyped;
 
 template <class S>
 double d(S v) { return ScalarTraits<S>::toDouble(v); }

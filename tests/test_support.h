@@ -31,4 +31,12 @@ inline Scenario singleTuft(ConstraintMode mode) {
   return s;
 }
 
+/// A World<S> for a scenario, validated for S first (tests that need typed access).
+template <class S>
+std::unique_ptr<World<S>> makeTyped(Scenario s) {
+  s.scalar = ScalarTraits<S>::kind;
+  validateForScalar(s, s.scalar, 0);
+  return std::make_unique<World<S>>(s, 1);
+}
+
 }  // namespace sg::test

@@ -50,11 +50,10 @@ int runScenario(const RunOptions& o) {
   StageClock clock;
   nlohmann::json hashes = nlohmann::json::array();
   ProgressBar progress("run", o.ticks, !o.json);
-  const TickInput input;
   const auto start = std::chrono::steady_clock::now();
   StepResult failure;
   for (int64_t t = 0; t < o.ticks; ++t) {
-    StepResult r = world->step(input, &clock);
+    StepResult r = world->step(scriptedInput(scenario, world->tick()), &clock);
     if (!r.ok) {
       failure = r;
       break;
@@ -86,7 +85,7 @@ int runScenario(const RunOptions& o) {
     j["threads"] = counts.threads;
     j["counts"] = {{"patchesX", counts.patchesX}, {"patchesZ", counts.patchesZ}, {"patches", counts.patches()},
                    {"particlesX", counts.particlesX}, {"particlesZ", counts.particlesZ},
-                   {"particles", counts.particles()}};
+                   {"particles", counts.particles()}, {"bodies", counts.bodies}, {"contacts", counts.contacts}};
     j["ticks"] = ran;
     j["finalHash"] = hex(finalHash);
     if (o.hashEvery > 0) j["hashes"] = hashes;
@@ -104,6 +103,8 @@ int runScenario(const RunOptions& o) {
     std::printf("patches    %" PRId64 " (%" PRId64 " x %" PRId64 "), particles %" PRId64 " (%" PRId64 " x %" PRId64 ")\n",
                 counts.patches(), counts.patchesX, counts.patchesZ, counts.particles(), counts.particlesX,
                 counts.particlesZ);
+    if (counts.bodies > 0)
+      std::printf("bodies     %" PRId64 ", %" PRId64 " contacts in the last tick\n", counts.bodies, counts.contacts);
     std::printf("ticks      %" PRId64 " (%.3f s simulated at dt = %s s)\n", ran,
                 double(ran) * scenario.timeStep.toDouble(), scenario.timeStep.toString().c_str());
     std::printf("hash       %s (state after tick %" PRId64 ")\n", hex(finalHash).c_str(), ran);

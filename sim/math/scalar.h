@@ -69,8 +69,13 @@ template <> struct ScalarTraits<double> : detail::FloatTraits<double, ScalarKind
 
 // float/double counterparts of the fixed-point free functions, so kernels are written once.
 // sqrt is IEEE correctly rounded (and an instruction with -fno-math-errno): deterministic.
+inline float abs(float v) { return std::fabs(v); }
+inline double abs(double v) { return std::fabs(v); }
 inline float length3(float x, float y, float z) { return std::sqrt(x * x + y * y + z * z); }
 inline double length3(double x, double y, double z) { return std::sqrt(x * x + y * y + z * z); }
+
+/// Expands M(S) once per scalar type: explicit template instantiations in the .cpp files.
+#define SG_FOR_EACH_SCALAR(M) M(::sg::Fx32) M(::sg::Fx16) M(float) M(double)
 
 /// Calls f.template operator()<S>() with the C++ type of a runtime scalar kind.
 template <class F>

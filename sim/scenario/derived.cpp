@@ -40,6 +40,7 @@ ScenarioConstants deriveConstants(const Scenario& s) {
   c.particlesX = (f.patchesX - 1 + k - 1) / k + 1;
   c.particlesZ = (f.patchesZ - 1 + k - 1) / k + 1;
   for (int t = 0; t < k; ++t) c.interpolationWeights.push_back(Rational{t, k});
+  c.invParticleSpacing = ok(div(Rational{1, 1}, ok(mul(f.spacing, Rational::integer(k)), "$.field.spacing")), "$.field.spacing");
 
   for (size_t g = 0; g < s.wind.schedule.size(); ++g) {
     const std::string path = "$.wind.schedule[" + std::to_string(g) + "]";

@@ -20,6 +20,7 @@ struct ScenarioConstants {
   Rational jitterAmplitude;  ///< m
   Rational fieldOriginX, fieldOriginZ;  ///< m, un-jittered position of patch (0, 0)
   int64_t particlesX = 0, particlesZ = 0;
+  Rational invParticleSpacing;  ///< 1 / (k spacing)
   std::vector<Rational> interpolationWeights;  ///< t/k for t = 0..k-1
   std::vector<std::array<Rational, 3>> gustForcePerMass;  ///< N/kg
   std::vector<int64_t> gustTicks;      ///< each gust's duration in ticks (>= 1)

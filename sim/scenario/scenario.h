@@ -30,6 +30,54 @@ enum class WindTravel : uint8_t {
   Forward,    ///< every gust travels +z (what the thesis code did: its loop order had no effect)
 };
 
+/// Rigid-body primitives (thesis §4: sphere and box; compounds are lists of them).
+enum class ShapeType : uint8_t { Sphere, Box };
+/// Which particles the body-particle stage tests against a body (results are identical).
+enum class ParticleBroadphase : uint8_t { Grid, Brute };
+/// Which body pairs the body-body stage tests (results are identical).
+enum class BodyBroadphase : uint8_t { Brute, SweepAndPrune };
+/// The push direction for a particle inside a box.
+enum class BoxParticleNormal : uint8_t {
+  Up,           ///< thesis: constant (0, 1, 0); the particle is pushed down, towards the ground
+  NearestFace,  ///< out through the nearest face
+};
+
+struct ShapeSpec {
+  ShapeType type = ShapeType::Sphere;
+  Rational radius{1, 2};                                      ///< m (sphere)
+  Rational3 halfExtents{Rational{1, 2}, Rational{1, 2}, Rational{1, 2}};  ///< m (box)
+  Rational3 offset{Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};       ///< m, in the body frame
+};
+
+struct BodySpec {
+  std::string name;
+  std::vector<ShapeSpec> parts;  ///< one for a sphere or a box; several for a compound
+  Rational mass{1, 1};           ///< kg
+  Rational3 position{Rational{0, 1}, Rational{1, 1}, Rational{0, 1}};
+  std::array<Rational, 4> orientation{Rational{1, 1}, Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};  ///< w, x, y, z
+  Rational3 velocity{Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
+  Rational3 angularVelocity{Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
+  Rational linearDamping{1, 1};   ///< per-second velocity factor
+  Rational angularDamping{1, 1};
+  Rational restitution{3, 10};
+  Rational friction{1, 2};
+  bool mower = false;             ///< cuts the grass it touches
+};
+
+/// One scripted command (the scenario's input track).
+enum class BodyCommandKind : uint8_t {
+  Displace,     ///< position += value (thesis "direct position change")
+  AddVelocity,  ///< velocity += value (thesis "velocity movement")
+  Impulse,      ///< velocity += value / mass
+  Teleport,     ///< position = value, velocities = 0
+};
+struct ScriptedCommand {
+  int64_t tick = 0;
+  int32_t body = 0;
+  BodyCommandKind kind = BodyCommandKind::AddVelocity;
+  Rational3 value{Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
+};
+
 struct WindGust {
   Rational3 force;    ///< N (mass 1: m/s^2)
   Rational duration;  ///< s
@@ -83,6 +131,17 @@ struct Scenario {
     Rational maxHeight{5, 1};   ///< m at sample value 255
     Rational centerX{0, 1}, centerZ{0, 1};  ///< m, world position of the heightmap centre
   } terrain;
+
+  struct Bodies {
+    Rational3 gravity{Rational{0, 1}, Rational{-981, 100}, Rational{0, 1}};  ///< m/s^2
+    int velocityIterations = 8;
+    int positionIterations = 8;  ///< per contact (Cyclone: twice the contact count)
+    ParticleBroadphase particleBroadphase = ParticleBroadphase::Grid;
+    BodyBroadphase bodyBroadphase = BodyBroadphase::Brute;
+    BoxParticleNormal boxParticleNormal = BoxParticleNormal::Up;
+    std::vector<BodySpec> list;
+  } bodies;
+  std::vector<ScriptedCommand> script;  ///< sorted by tick, then body
 
   std::string sourceName = "<built-in>";  ///< file name for error messages
   std::string text;                       ///< the JSON text it was parsed from

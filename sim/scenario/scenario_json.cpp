@@ -1,6 +1,7 @@
 // Scenario JSON -> Scenario, with one-line errors that name the file, the JSON path and what
 // was expected. Numbers are read from their raw text (collected by a SAX pass) so that the
 // decimal -> fixed-point conversion is exact.
+#include <algorithm>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -293,6 +294,134 @@ void parseTerrain(const Reader& r, const json& j, Scenario::Terrain& t, const Sc
     r.fail(p + ".file", "'" + t.heightmapPath + "' to be " + why);
 }
 
+ShapeSpec parseShapePart(const Reader& r, const json& j, const std::string& p, bool allowOffset) {
+  ShapeSpec part;
+  if (allowOffset) r.object(j, p, {"type", "radius", "halfExtents", "offset"});
+  if (!j.contains("type")) r.fail(p + ".type", "\"sphere\" or \"box\" (missing)");
+  part.type = r.choice<ShapeType>(j["type"], p + ".type", {{"sphere", ShapeType::Sphere}, {"box", ShapeType::Box}});
+  if (part.type == ShapeType::Sphere) {
+    if (j.contains("halfExtents")) r.fail(p + ".halfExtents", "no 'halfExtents' for a sphere (use radius)");
+    if (!j.contains("radius")) r.fail(p + ".radius", "a sphere radius in m (missing)");
+    part.radius = r.positive(j["radius"], p + ".radius");
+  } else {
+    if (j.contains("radius")) r.fail(p + ".radius", "no 'radius' for a box (use halfExtents)");
+    if (!j.contains("halfExtents")) r.fail(p + ".halfExtents", "box half extents [x, y, z] in m (missing)");
+    part.halfExtents = r.vector<3>(j["halfExtents"], p + ".halfExtents");
+    for (int i = 0; i < 3; ++i)
+      if (part.halfExtents[size_t(i)].num <= 0)
+        r.failGot(p + ".halfExtents[" + std::to_string(i) + "]", "a positive half extent", j["halfExtents"][size_t(i)]);
+  }
+  if (j.contains("offset")) part.offset = r.vector<3>(j["offset"], p + ".offset");
+  return part;
+}
+
+BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
+  BodySpec b;
+  r.object(j, p, {"name", "shape", "mass", "position", "orientation", "velocity", "angularVelocity", "linearDamping",
+                  "angularDamping", "restitution", "friction", "mower"});
+  if (!j.contains("name")) r.fail(p + ".name", "a body name (missing)");
+  b.name = r.string(j["name"], p + ".name");
+  if (!j.contains("shape")) r.fail(p + ".shape", "a shape {\"type\": \"sphere\" | \"box\" | \"compound\", ...} (missing)");
+  const json& sh = j["shape"];
+  const std::string sp = p + ".shape";
+  r.object(sh, sp, {"type", "radius", "halfExtents", "parts"});
+  if (sh.contains("type") && sh["type"] == "compound") {
+    if (!sh.contains("parts") || !sh["parts"].is_array() || sh["parts"].empty() || sh["parts"].size() > 16)
+      r.fail(sp + ".parts", "an array of 1 to 16 sphere/box parts");
+    for (size_t i = 0; i < sh["parts"].size(); ++i)
+      b.parts.push_back(parseShapePart(r, sh["parts"][i], sp + ".parts[" + std::to_string(i) + "]", true));
+  } else {
+    if (sh.contains("parts")) r.fail(sp + ".parts", "no 'parts' unless \"type\": \"compound\"");
+    b.parts.push_back(parseShapePart(r, sh, sp, false));
+  }
+  if (j.contains("mass")) b.mass = r.positive(j["mass"], p + ".mass");
+  if (j.contains("position")) b.position = r.vector<3>(j["position"], p + ".position");
+  if (j.contains("orientation")) {
+    b.orientation = r.vector<4>(j["orientation"], p + ".orientation");
+    bool nonZero = false;
+    for (const Rational& q : b.orientation) nonZero = nonZero || q.num != 0;
+    if (!nonZero) r.failGot(p + ".orientation", "a non-zero quaternion [w, x, y, z]", j["orientation"]);
+  }
+  if (j.contains("velocity")) b.velocity = r.vector<3>(j["velocity"], p + ".velocity");
+  if (j.contains("angularVelocity")) b.angularVelocity = r.vector<3>(j["angularVelocity"], p + ".angularVelocity");
+  auto factor = [&](const char* key, Rational& out) {
+    if (!j.contains(key)) return;
+    out = r.positive(j[key], p + "." + key);
+    if (compare(out, Rational{1, 1}) > 0) r.failGot(p + "." + key, "a damping factor in (0, 1]", j[key]);
+  };
+  factor("linearDamping", b.linearDamping);
+  factor("angularDamping", b.angularDamping);
+  if (j.contains("restitution")) {
+    b.restitution = r.nonNegative(j["restitution"], p + ".restitution");
+    if (compare(b.restitution, Rational{1, 1}) > 0) r.failGot(p + ".restitution", "a restitution in [0, 1]", j["restitution"]);
+  }
+  if (j.contains("friction")) b.friction = r.nonNegative(j["friction"], p + ".friction");
+  if (j.contains("mower")) {
+    if (!j["mower"].is_boolean()) r.failGot(p + ".mower", "true or false", j["mower"]);
+    b.mower = j["mower"].get<bool>();
+  }
+  return b;
+}
+
+void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
+  const std::string p = "$.bodies";
+  r.object(j, p, {"gravity", "velocityIterations", "positionIterations", "particleBroadphase", "bodyBroadphase",
+                  "boxParticleNormal", "list"});
+  if (j.contains("gravity")) b.gravity = r.vector<3>(j["gravity"], p + ".gravity");
+  if (j.contains("velocityIterations"))
+    b.velocityIterations = int(r.integer(j["velocityIterations"], p + ".velocityIterations", 1, 1000));
+  if (j.contains("positionIterations"))
+    b.positionIterations = int(r.integer(j["positionIterations"], p + ".positionIterations", 0, 1000));
+  if (j.contains("particleBroadphase"))
+    b.particleBroadphase = r.choice<ParticleBroadphase>(j["particleBroadphase"], p + ".particleBroadphase",
+                                                        {{"grid", ParticleBroadphase::Grid}, {"brute", ParticleBroadphase::Brute}});
+  if (j.contains("bodyBroadphase"))
+    b.bodyBroadphase = r.choice<BodyBroadphase>(j["bodyBroadphase"], p + ".bodyBroadphase",
+                                                {{"brute", BodyBroadphase::Brute}, {"sap", BodyBroadphase::SweepAndPrune}});
+  if (j.contains("boxParticleNormal"))
+    b.boxParticleNormal = r.choice<BoxParticleNormal>(j["boxParticleNormal"], p + ".boxParticleNormal",
+                                                      {{"up", BoxParticleNormal::Up}, {"nearest-face", BoxParticleNormal::NearestFace}});
+  if (j.contains("list")) {
+    const json& l = j["list"];
+    if (!l.is_array() || l.size() > 1024) r.failGot(p + ".list", "an array of at most 1024 bodies", l);
+    for (size_t i = 0; i < l.size(); ++i) {
+      const std::string q = p + ".list[" + std::to_string(i) + "]";
+      b.list.push_back(parseBody(r, l[i], q));
+      for (size_t k = 0; k + 1 < b.list.size(); ++k)
+        if (b.list[k].name == b.list.back().name) r.fail(q + ".name", "a unique body name, '" + b.list.back().name + "' is taken");
+    }
+  }
+}
+
+void parseScript(const Reader& r, const json& j, Scenario& s) {
+  const std::string p = "$.script";
+  if (!j.is_array() || j.size() > 1000000) r.failGot(p, "an array of commands", j);
+  for (size_t i = 0; i < j.size(); ++i) {
+    const std::string q = p + "[" + std::to_string(i) + "]";
+    const json& c = j[i];
+    r.object(c, q, {"tick", "body", "command", "value"});
+    ScriptedCommand cmd;
+    if (!c.contains("tick")) r.fail(q + ".tick", "the tick the command applies to (missing)");
+    cmd.tick = r.integer(c["tick"], q + ".tick", 0, int64_t(1) << 40);
+    if (!c.contains("body")) r.fail(q + ".body", "a body name (missing)");
+    const std::string name = r.string(c["body"], q + ".body");
+    cmd.body = -1;
+    for (size_t k = 0; k < s.bodies.list.size(); ++k)
+      if (s.bodies.list[k].name == name) cmd.body = int32_t(k);
+    if (cmd.body < 0) r.failGot(q + ".body", "the name of a body in $.bodies.list", c["body"]);
+    if (!c.contains("command")) r.fail(q + ".command", "a command (missing)");
+    cmd.kind = r.choice<BodyCommandKind>(c["command"], q + ".command",
+                                         {{"displace", BodyCommandKind::Displace}, {"addVelocity", BodyCommandKind::AddVelocity},
+                                          {"impulse", BodyCommandKind::Impulse}, {"teleport", BodyCommandKind::Teleport}});
+    if (!c.contains("value")) r.fail(q + ".value", "a vector [x, y, z] (missing)");
+    cmd.value = r.vector<3>(c["value"], q + ".value");
+    s.script.push_back(cmd);
+  }
+  std::stable_sort(s.script.begin(), s.script.end(), [](const ScriptedCommand& a, const ScriptedCommand& b) {
+    return a.tick < b.tick;
+  });
+}
+
 std::string lineColumn(const std::string& text, size_t byte) {
   size_t line = 1, col = 1;
   for (size_t i = 0; i < byte && i < text.size(); ++i) {
@@ -356,7 +485,8 @@ Scenario parseScenario(const std::string& text, const std::string& sourceName, c
   Scenario s;
   s.sourceName = sourceName;
   s.text = text;
-  r.object(root, "$", {"format", "name", "description", "seed", "scalar", "timeStep", "field", "particles", "wind", "terrain"});
+  r.object(root, "$", {"format", "name", "description", "seed", "scalar", "timeStep", "field", "particles", "wind", "terrain",
+                       "bodies", "script"});
   if (root.contains("format") && root["format"] != "simgrass-scenario/1")
     r.failGot("$.format", "\"simgrass-scenario/1\"", root["format"]);
   if (root.contains("name")) s.name = r.string(root["name"], "$.name");
@@ -379,6 +509,8 @@ Scenario parseScenario(const std::string& text, const std::string& sourceName, c
   if (root.contains("particles")) parseParticles(r, root["particles"], s.particles);
   if (root.contains("wind")) parseWind(r, root["wind"], s.wind);
   if (root.contains("terrain")) parseTerrain(r, root["terrain"], s.terrain, readFile);
+  if (root.contains("bodies")) parseBodies(r, root["bodies"], s.bodies);
+  if (root.contains("script")) parseScript(r, root["script"], s);
   if (s.wind.schedule.empty()) {
     // An empty schedule is allowed: no wind.
   }

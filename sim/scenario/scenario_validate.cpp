@@ -2,6 +2,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "sim/bodies/rigid_body.h"
 #include "sim/scenario/derived.h"
 
 namespace sg {
@@ -124,7 +125,44 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
       fits(derived.terrainOriginZ, "$.terrain.center[1]");
       fits(s.terrain.maxHeight, "$.terrain.maxHeight");
     }
+    // Bodies: every value fits, positions within the coordinate range, mass properties exact.
+    for (int c = 0; c < 3; ++c) fits(s.bodies.gravity[size_t(c)], "$.bodies.gravity[" + std::to_string(c) + "]");
+    for (size_t i = 0; i < s.bodies.list.size(); ++i) {
+      const BodySpec& b = s.bodies.list[i];
+      const std::string q = "$.bodies.list[" + std::to_string(i) + "]";
+      for (int c = 0; c < 3; ++c) {
+        const std::string ix = "[" + std::to_string(c) + "]";
+        fits(b.position[size_t(c)], q + ".position" + ix);
+        fits(b.velocity[size_t(c)], q + ".velocity" + ix);
+        fits(b.angularVelocity[size_t(c)], q + ".angularVelocity" + ix);
+      }
+      for (int c = 0; c < 4; ++c) fits(b.orientation[size_t(c)], q + ".orientation[" + std::to_string(c) + "]");
+      for (size_t k = 0; k < b.parts.size(); ++k) {
+        const std::string pp = b.parts.size() == 1 ? q + ".shape" : q + ".shape.parts[" + std::to_string(k) + "]";
+        fits(b.parts[k].radius, pp + ".radius");
+        for (int c = 0; c < 3; ++c) {
+          fits(b.parts[k].halfExtents[size_t(c)], pp + ".halfExtents[" + std::to_string(c) + "]");
+          fits(b.parts[k].offset[size_t(c)], pp + ".offset[" + std::to_string(c) + "]");
+        }
+      }
+      fits(b.mass, q + ".mass");
+      try {
+        (void)makeBody<S>(b, s.timeStep, s.sourceName, q);
+      } catch (const std::out_of_range&) {
+        throw ScenarioError(s.sourceName, q + ".mass",
+                            std::string("mass properties (1/mass, 1/inertia) within the ") +
+                                scalarName(ScalarTraits<S>::kind) + " range");
+      }
+    }
     checkResolution<S>(s);
   });
+  // Scripted values are recorded as Q32.32 inputs: they must fit that format.
+  for (size_t i = 0; i < s.script.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const auto raw = s.script[i].value[size_t(c)].toScaledInteger(32);
+      if (!raw || *raw > __int128(INT64_MAX) || *raw < __int128(INT64_MIN))
+        throw ScenarioError(s.sourceName, "$.script[" + std::to_string(i) + "].value[" + std::to_string(c) + "]",
+                            "a value within +-2147483647 (inputs are Q32.32)");
+    }
 }
 }  // namespace sg

@@ -1,5 +1,7 @@
 #include "sim/terrain/terrain.h"
 
+#include <algorithm>
+
 namespace sg {
 namespace {
 template <class S>
@@ -61,6 +63,19 @@ void Terrain<S>::normalAt(S x, S z, S* nx, S* ny, S* nz) const {
   *nx = -dhdx / len;
   *ny = S(1) / len;
   *nz = -dhdz / len;
+}
+
+template <class S>
+void Terrain<S>::samplesInside(S x, S z, S radius, std::vector<std::pair<S, S>>& out) const {
+  out.clear();
+  if (flat_) return;
+  const int64_t x0 = std::max<int64_t>(0, floorToInt((x - radius - originX_) * invCellSize_));
+  const int64_t x1 = std::min<int64_t>(width_ - 1, floorToInt((x + radius - originX_) * invCellSize_) + 1);
+  const int64_t z0 = std::max<int64_t>(0, floorToInt((z - radius - originZ_) * invCellSize_));
+  const int64_t z1 = std::min<int64_t>(depth_ - 1, floorToInt((z + radius - originZ_) * invCellSize_) + 1);
+  for (int64_t iz = z0; iz <= z1; ++iz)
+    for (int64_t ix = x0; ix <= x1; ++ix)
+      out.emplace_back(originX_ + mulInt(cellSize_, ix), originZ_ + mulInt(cellSize_, iz));
 }
 
 template class Terrain<Fx32>;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "sim/math/scalar_ops.h"
@@ -22,6 +23,9 @@ class Terrain {
   S heightAt(S x, S z) const;
   /// Unit normal at world (x, z): the normalised (-dh/dx, 1, -dh/dz) of the bilinear patch.
   void normalAt(S x, S z, S* nx, S* ny, S* nz) const;
+  /// World (x, z) of the heightmap samples within `radius` of (x, z) on both axes, row by row
+  /// (none for a flat terrain).
+  void samplesInside(S x, S z, S radius, std::vector<std::pair<S, S>>& out) const;
 
  private:
   struct Cell {

@@ -8,7 +8,8 @@ namespace sg {
 
 enum class Stage : uint8_t {
   Wind = 0,         ///< per-row wind force and particle acceleration        (sim/wind)
-  Collision,        ///< body contacts (rigid-body issue; skipped without bodies)
+  Collision,        ///< body-body and body-terrain contacts                 (sim/collision)
+  Response,         ///< gravity, contact impulses, projection, grass push   (sim/collision)
   Integrate,        ///< p += v dt; v += a dt; v *= damping^dt              (sim/particles)
   Constraints,      ///< rod projection back to length L                     (sim/particles)
   PatchState,       ///< interpolation, tip offsets, tilt levels             (sim/patches)
@@ -19,6 +20,7 @@ inline const char* stageName(Stage s) {
   switch (s) {
     case Stage::Wind: return "wind";
     case Stage::Collision: return "collision";
+    case Stage::Response: return "response";
     case Stage::Integrate: return "integrate";
     case Stage::Constraints: return "constraints";
     case Stage::PatchState: return "patch-state";

@@ -3,6 +3,9 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
+
+#include "sim/scenario/scenario.h"
 
 namespace sg {
 
@@ -12,12 +15,27 @@ struct InputVec3 {
   friend bool operator==(const InputVec3&, const InputVec3&) = default;
 };
 
+/// One command to one body, applied at the start of the tick (thesis keys T/F/G/H/U/J map to
+/// Displace or AddVelocity along the camera's axes; the viewer issue does that mapping).
+struct BodyCommand {
+  int32_t body = 0;
+  BodyCommandKind kind = BodyCommandKind::AddVelocity;
+  InputVec3 value;  ///< m, m/s or N s depending on the kind
+  friend bool operator==(const BodyCommand&, const BodyCommand&) = default;
+};
+
 struct TickInput {
   /// Camera position for the level-of-detail window (the LOD issue); ignored until then.
   bool hasCamera = false;
   InputVec3 camera;
-  // Body commands (moves, impulses, teleports) arrive with the rigid-body issue.
+  std::vector<BodyCommand> bodies;  ///< applied in order
   friend bool operator==(const TickInput&, const TickInput&) = default;
 };
+
+/// The scenario's scripted commands for one tick (empty when it has none).
+TickInput scriptedInput(const Scenario& scenario, int64_t tick);
+
+/// Q32.32 raw of an exact value (saturating; scenario validation keeps values in range).
+int64_t toInputRaw(const Rational& value);
 
 }  // namespace sg

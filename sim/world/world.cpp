@@ -4,6 +4,8 @@
 #include <bit>
 #include <cstring>
 
+#include "sim/bodies/integrate_bodies.h"
+#include "sim/collision/body_pairs.h"
 #include "sim/particles/integrate.h"
 #include "sim/particles/rod_constraint.h"
 #include "sim/world/state_sink.h"
@@ -57,12 +59,35 @@ uint64_t scenarioFingerprint(const Scenario& s) {
     hashRational(h, g.duration);
   }
   h.write(s.terrain.heightmap.samples.data(), s.terrain.heightmap.samples.size());
+  if (!s.bodies.list.empty()) {  // worlds without bodies keep the fingerprint they always had
+    const auto& b = s.bodies;
+    // Not the broad phases: they are promised to give the same state, so they must not change it.
+    const int64_t settings[] = {b.velocityIterations, b.positionIterations, int64_t(b.boxParticleNormal),
+                                int64_t(b.list.size())};
+    h.write(settings, sizeof settings);
+    for (const Rational& g : b.gravity) hashRational(h, g);
+    for (const BodySpec& body : b.list) {
+      h.write(body.name.data(), body.name.size());
+      for (const ShapeSpec& part : body.parts) {
+        const int64_t type = int64_t(part.type);
+        h.write(&type, sizeof type);
+        hashRational(h, part.radius);
+        for (const Rational& r : part.halfExtents) hashRational(h, r);
+        for (const Rational& r : part.offset) hashRational(h, r);
+      }
+      for (const Rational* r : {&body.mass, &body.linearDamping, &body.angularDamping, &body.restitution, &body.friction})
+        hashRational(h, *r);
+      const int64_t mower = body.mower;
+      h.write(&mower, sizeof mower);
+    }
+  }
   return h.digest();
 }
 }  // namespace
 
 std::string SimError::message() const {
   std::string m = "simulation error at tick " + std::to_string(tick) + ", stage '" + stageName(stage) + "'";
+  if (body >= 0) m += ", body " + std::to_string(body);
   if (particle >= 0)
     m += ", particle " + std::to_string(particle) + " (patch " + std::to_string(latticeI) + ", " +
          std::to_string(latticeJ) + ")";
@@ -118,6 +143,28 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   windConsts_.accZ = toS<S>(s.particles.acceleration[2]);
   windConsts_.dt = particleConsts_.dt;
   windSchedule_ = WindSchedule::build(s, c);
+
+  // Rigid bodies.
+  for (size_t i = 0; i < s.bodies.list.size(); ++i)
+    bodies_.push_back(makeBody<S>(s.bodies.list[i], s.timeStep, s.sourceName, "$.bodies.list[" + std::to_string(i) + "]"));
+  gravityDt_ = Vec3<S>(toS<S>(s.bodies.gravity[0]), toS<S>(s.bodies.gravity[1]), toS<S>(s.bodies.gravity[2])) *
+               particleConsts_.dt;
+  solver_.velocityIterations = s.bodies.velocityIterations;
+  solver_.positionIterationsPerContact = s.bodies.positionIterations;
+  // Approaches slower than 1 m/s do not bounce (Box2D's b2_velocityThreshold): below that,
+  // restitution plus the energy the position projection adds keeps a ball hopping forever.
+  solver_.restitutionThreshold = S(1);
+  solver_.linearSlop = toS<S>(Rational{1, 2000});  // 0.5 mm
+  bodyBroadphase_ = s.bodies.bodyBroadphase;
+  bodyParticle_.boxNormal = s.bodies.boxParticleNormal;
+  bodyParticle_.broadphase = s.bodies.particleBroadphase;
+  bodyParticle_.particleInvMass = toS<S>(c.invMass);
+  S largest(0);
+  for (const RigidBody<S>& b : bodies_) largest = maxS(largest, b.boundingRadius);
+  bodyParticle_.margin = particleConsts_.rodLength + lattice_.jitterAmplitude + largest;
+  bodyParticle_.anchorOriginX = lattice_.originX;
+  bodyParticle_.anchorOriginZ = lattice_.originZ;
+  bodyParticle_.invParticleSpacing = toS<S>(c.invParticleSpacing);
 
   // Patches: static attributes from the lattice hash, roots on the terrain.
   const size_t nPatches = size_t(f.patchesX * f.patchesZ);
@@ -178,7 +225,8 @@ void World<S>::setThreads(int threads) {
 
 template <class S>
 WorldCounts World<S>::counts() const {
-  return {lattice_.patchesX, lattice_.patchesZ, grid_.countX, grid_.countZ, grid_.k, pool_->threads()};
+  return {lattice_.patchesX, lattice_.patchesZ, grid_.countX, grid_.countZ, grid_.k, pool_->threads(),
+          int64_t(bodies_.size()), int64_t(contacts_.size())};
 }
 
 // ---- the step -------------------------------------------------------------------------------
@@ -235,23 +283,105 @@ void World<S>::updatePatchState() {
 }
 
 template <class S>
-StepResult World<S>::step(const TickInput& /*input: camera and bodies arrive with later stages*/,
-                          StageObserver* observer) {
+void World<S>::applyCommands(const TickInput& input) {
+  for (const BodyCommand& cmd : input.bodies) {
+    if (cmd.body < 0 || size_t(cmd.body) >= bodies_.size()) continue;  // validated by the reader
+    RigidBody<S>& b = bodies_[size_t(cmd.body)];
+    const Vec3<S> v(ScalarTraits<S>::fromRational(Rational{cmd.value.x, int64_t(1) << 32}).value_or(S(0)),
+                    ScalarTraits<S>::fromRational(Rational{cmd.value.y, int64_t(1) << 32}).value_or(S(0)),
+                    ScalarTraits<S>::fromRational(Rational{cmd.value.z, int64_t(1) << 32}).value_or(S(0)));
+    switch (cmd.kind) {
+      case BodyCommandKind::Displace: b.position += v; break;
+      case BodyCommandKind::AddVelocity: b.velocity += v; break;
+      case BodyCommandKind::Impulse: b.velocity += v * b.invMass; break;
+      case BodyCommandKind::Teleport:
+        b.position = v;
+        b.velocity = Vec3<S>::Zero();
+        b.angularVelocity = Vec3<S>::Zero();
+        break;
+    }
+  }
+}
+
+template <class S>
+void World<S>::detectContacts() {
+  contacts_.clear();
+  for (const auto& [i, j] : bodyPairs(bodies_, bodyBroadphase_))
+    collideBodies(i, bodies_[size_t(i)], j, bodies_[size_t(j)], contacts_);
+  for (size_t i = 0; i < bodies_.size(); ++i) collideBodyTerrain(int32_t(i), bodies_[i], terrain_, contacts_);
+  sortContacts(contacts_);
+}
+
+template <class S>
+bool World<S>::bodiesFaulted(Stage stage) {
+  using T = ScalarTraits<S>;
+  const uint32_t faults = takeFixedFaults();
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    const RigidBody<S>& b = bodies_[i];
+    bool finite = true;
+    for (int k = 0; k < 3; ++k)
+      finite = finite && T::isFinite(b.position[k]) && T::isFinite(b.velocity[k]) && T::isFinite(b.angularVelocity[k]);
+    if (faults == 0 && finite) continue;
+    failed_ = true;
+    failure_ = SimError{};
+    failure_.tick = tick_;
+    failure_.stage = stage;
+    failure_.body = int32_t(i);
+    failure_.what = faults ? fixedFaultName(faults) : "non-finite value";
+    return true;
+  }
+  return false;
+}
+
+template <class S>
+bool World<S>::respondToContacts() {
+  applyGravity(bodies_, gravityDt_);
+  solveContactVelocities(bodies_, contacts_, solver_);
+  solveContactPositions(bodies_, contacts_, solver_);
+  if (bodiesFaulted(Stage::Response)) return false;
+  // Grass: pushed out of every body (particle rows in parallel, bodies in id order).
+  const std::vector<ParticleRange> ranges = particleRanges(bodies_, grid_, bodyParticle_);
+  return runParticleRows(Stage::Response, [&](int64_t row, int64_t, int64_t) {
+    return pushParticlesOutOfBodies(particles_, grid_, bodies_, ranges, bodyParticle_, row, row + 1);
+  });
+}
+
+template <class S>
+StepResult World<S>::step(const TickInput& input, StageObserver* observer) {
   if (failed_) return {false, failure_};
   auto begin = [&](Stage st) { if (observer) observer->stageBegin(st); };
   auto end = [&](Stage st) { if (observer) observer->stageEnd(st); };
+  const bool hasBodies = !bodies_.empty();
+  takeFixedFaults();
+  if (hasBodies) {
+    applyCommands(input);
+    if (bodiesFaulted(Stage::Collision)) return {false, failure_};
+  }
 
   begin(Stage::Wind);
-  takeFixedFaults();
   computeRowAcceleration(windSchedule_, windConsts_, tick_, &rowAccel_);
   if (const uint32_t f = takeFixedFaults()) {
     failed_ = true;
-    failure_ = SimError{tick_, Stage::Wind, -1, 0, 0, fixedFaultName(f)};
+    failure_ = SimError{};
+    failure_.tick = tick_;
+    failure_.stage = Stage::Wind;
+    failure_.what = fixedFaultName(f);
   }
   end(Stage::Wind);
   if (failed_) return {false, failure_};
 
-  // Stage::Collision: no bodies in this scenario kind yet, so the stage costs nothing.
+  // A scenario without bodies pays nothing for the two body stages.
+  if (hasBodies) {
+    begin(Stage::Collision);
+    detectContacts();
+    const bool detected = !bodiesFaulted(Stage::Collision);
+    end(Stage::Collision);
+    if (!detected) return {false, failure_};
+    begin(Stage::Response);
+    const bool responded = respondToContacts();
+    end(Stage::Response);
+    if (!responded) return {false, failure_};
+  }
 
   const ParticleConstants<S>& c = particleConsts_;
   const bool pbd = constraintMode_ == ConstraintMode::Pbd;
@@ -261,6 +391,10 @@ StepResult World<S>::step(const TickInput& /*input: camera and bodies arrive wit
     return pbd ? integrateParticleRow<S, true>(particles_, b, e, dvx, dvy, dvz, c)
                : integrateParticleRow<S, false>(particles_, b, e, dvx, dvy, dvz, c);
   });
+  if (integrated && hasBodies) {
+    integrateBodyPositions(bodies_, c.dt);
+    if (bodiesFaulted(Stage::Integrate)) return {false, failure_};
+  }
   end(Stage::Integrate);
   if (!integrated) return {false, failure_};
 
@@ -286,11 +420,14 @@ void World<S>::serialise(StateSink& sink) const {
   // Header (40 bytes, little-endian): magic, version, scalar, k, reserved, fingerprint, tick,
   // particle count. Then px, py, pz, vx, vy, vz as raw scalar bits, then the count of persistent
   // patch edits (mower cuts; always 0 until the rigid-body issue).
+  static_assert(sizeof(S) * 13 == sizeof(S[13]));
   uint8_t header[kStateHeaderBytes] = {};
   std::memcpy(header, kStateMagic, 8);
   std::memcpy(header + 8, &kStateVersion, 4);
   header[12] = uint8_t(ScalarTraits<S>::kind);
   header[13] = uint8_t(grid_.k);
+  const uint16_t bodyCount = uint16_t(bodies_.size());
+  std::memcpy(header + 14, &bodyCount, 2);
   std::memcpy(header + 16, &configHash_, 8);
   std::memcpy(header + 24, &tick_, 8);
   const int64_t n = grid_.size();
@@ -298,6 +435,13 @@ void World<S>::serialise(StateSink& sink) const {
   sink.write(header, sizeof header);
   for (const auto* v : {&particles_.px, &particles_.py, &particles_.pz, &particles_.vx, &particles_.vy, &particles_.vz})
     sink.write(v->data(), v->size() * sizeof(S));
+  // Bodies (only when there are any, so body-free states are unchanged): 13 scalars each.
+  for (const RigidBody<S>& b : bodies_) {
+    const S values[13] = {b.position.x(), b.position.y(), b.position.z(), b.orientation.w(), b.orientation.x(),
+                          b.orientation.y(), b.orientation.z(), b.velocity.x(), b.velocity.y(), b.velocity.z(),
+                          b.angularVelocity.x(), b.angularVelocity.y(), b.angularVelocity.z()};
+    sink.write(values, sizeof values);
+  }
   const uint64_t edits = 0;
   sink.write(&edits, sizeof edits);
 }
@@ -320,7 +464,8 @@ std::vector<uint8_t> World<S>::saveState() const {
 template <class S>
 void World<S>::restoreState(std::span<const uint8_t> bytes) {
   const size_t n = size_t(grid_.size());
-  const size_t expectedSize = kStateHeaderBytes + 6 * n * sizeof(S) + 8;
+  const size_t bodyBytes = bodies_.size() * 13 * sizeof(S);
+  const size_t expectedSize = kStateHeaderBytes + 6 * n * sizeof(S) + bodyBytes + 8;
   if (bytes.size() < kStateHeaderBytes) throw StateError(bytes.size(), "a 40-byte state header (the data ends early)");
   if (std::memcmp(bytes.data(), kStateMagic, 8) != 0) throw StateError(0, "the state magic 'SGSTATE1'");
   uint32_t version;
@@ -330,6 +475,9 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   if (bytes[12] != uint8_t(ScalarTraits<S>::kind))
     throw StateError(12, std::string("a state of scalar ") + scalarName(ScalarTraits<S>::kind));
   if (bytes[13] != uint8_t(grid_.k)) throw StateError(13, "interpolation k = " + std::to_string(grid_.k));
+  uint16_t bodyCount;
+  std::memcpy(&bodyCount, bytes.data() + 14, 2);
+  if (bodyCount != bodies_.size()) throw StateError(14, std::to_string(bodies_.size()) + " bodies, got " + std::to_string(bodyCount));
   uint64_t fingerprint;
   std::memcpy(&fingerprint, bytes.data() + 16, 8);
   if (fingerprint != configHash_) throw StateError(16, "a state saved from the same scenario (fingerprint differs)");
@@ -348,6 +496,16 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   for (auto* v : {&particles_.px, &particles_.py, &particles_.pz, &particles_.vx, &particles_.vy, &particles_.vz}) {
     std::memcpy(v->data(), src, n * sizeof(S));
     src += n * sizeof(S);
+  }
+  for (RigidBody<S>& b : bodies_) {
+    S v[13];
+    std::memcpy(v, src, sizeof v);
+    src += sizeof v;
+    b.position = Vec3<S>(v[0], v[1], v[2]);
+    b.orientation = Quat<S>(v[3], v[4], v[5], v[6]);
+    b.velocity = Vec3<S>(v[7], v[8], v[9]);
+    b.angularVelocity = Vec3<S>(v[10], v[11], v[12]);
+    b.updateDerived();
   }
   tick_ = tick;
   failed_ = false;

@@ -15,6 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "sim/bodies/rigid_body.h"
+#include "sim/collision/body_particles.h"
+#include "sim/collision/contact_solver.h"
 #include "sim/field/grass_field.h"
 #include "sim/particles/particles.h"
 #include "sim/patches/patch_state.h"
@@ -32,6 +35,7 @@ struct SimError {
   int64_t tick = -1;
   Stage stage = Stage::Count;
   int64_t particle = -1;  ///< particle index, -1 if not particle-specific
+  int32_t body = -1;      ///< body index, -1 if not body-specific
   int64_t latticeI = 0, latticeJ = 0;  ///< patch coordinates of that particle
   std::string what;        ///< "fixed-point overflow", "non-finite value", ...
   std::string message() const;
@@ -56,6 +60,8 @@ struct WorldCounts {
   int64_t particlesX = 0, particlesZ = 0;
   int interpolation = 1;
   int threads = 1;
+  int64_t bodies = 0;
+  int64_t contacts = 0;  ///< body contacts found in the last tick
   int64_t patches() const { return patchesX * patchesZ; }
   int64_t particles() const { return particlesX * particlesZ; }
 };
@@ -103,6 +109,9 @@ class World final : public SimWorld {
   const Terrain<S>& terrain() const { return terrain_; }
   const WindSchedule& wind() const { return windSchedule_; }
   const RowAccelerationDt<S>& rowAcceleration() const { return rowAccel_; }
+  const std::vector<RigidBody<S>>& bodies() const { return bodies_; }
+  std::vector<RigidBody<S>>& mutableBodies() { return bodies_; }  ///< tests: set up states
+  const std::vector<Contact<S>>& contacts() const { return contacts_; }  ///< last tick's
   const ParticleConstants<S>& particleConstants() const { return particleConsts_; }
   /// Recomputes the derived patch state from the particles (done by step and restore).
   void updatePatchState();
@@ -110,6 +119,10 @@ class World final : public SimWorld {
  private:
   template <class Fn>
   bool runParticleRows(Stage stage, Fn&& rowKernel);
+  void applyCommands(const TickInput& input);
+  void detectContacts();
+  bool respondToContacts();
+  bool bodiesFaulted(Stage stage);
   void serialise(class StateSink& sink) const;
 
   uint64_t configHash_ = 0;
@@ -124,6 +137,12 @@ class World final : public SimWorld {
   WindSchedule windSchedule_;
   WindConstants<S> windConsts_;
   RowAccelerationDt<S> rowAccel_;
+  std::vector<RigidBody<S>> bodies_;
+  std::vector<Contact<S>> contacts_;
+  SolverSettings<S> solver_;
+  BodyParticleSettings<S> bodyParticle_;
+  BodyBroadphase bodyBroadphase_ = BodyBroadphase::Brute;
+  Vec3<S> gravityDt_ = Vec3<S>::Zero();
   std::vector<S> dispX_, dispY_, dispZ_;  ///< per-particle tip displacement (patch-state scratch)
   std::vector<S> rowScratch_;             ///< per-worker interpolation row
   int64_t rowsPerChunk_ = 1;

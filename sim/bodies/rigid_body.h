@@ -1,0 +1,64 @@
+// Rigid bodies: spheres, oriented boxes and compounds of them (thesis §4 "Rigid bodies"; the
+// thesis names the lack of compounds as a limit, a mower is one). Plain data; the stages that
+// move them live in sim/bodies/integrate_bodies.h and sim/collision/.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "sim/collision/contact.h"
+#include "sim/scenario/scenario.h"
+
+namespace sg {
+
+template <class S>
+struct BodyPart {
+  ShapeType type = ShapeType::Sphere;
+  S radius{};                               ///< m (sphere)
+  Vec3<S> halfExtents = Vec3<S>::Zero();    ///< m (box)
+  Vec3<S> offset = Vec3<S>::Zero();         ///< m, centre in the body frame (from the centre of mass)
+  S boundingRadius{};                       ///< m, around the part centre
+};
+
+template <class S>
+struct RigidBody {
+  // --- constant properties -------------------------------------------------------------------
+  std::vector<BodyPart<S>> parts;
+  S invMass{};                                 ///< 1/kg
+  Vec3<S> invInertiaLocal = Vec3<S>::Zero();   ///< principal inverse inertia (body axes), 1/(kg m^2)
+  S linearDampingPerTick{1}, angularDampingPerTick{1};  ///< damping^dt
+  S restitution{}, friction{};
+  S boundingRadius{};                          ///< m, around the centre of mass: covers every part
+  bool mower = false;
+  // --- state (saved, hashed) -----------------------------------------------------------------
+  Vec3<S> position = Vec3<S>::Zero();          ///< centre of mass (m)
+  Quat<S> orientation = Quat<S>::Identity();   ///< unit quaternion, body -> world
+  Vec3<S> velocity = Vec3<S>::Zero();          ///< m/s
+  Vec3<S> angularVelocity = Vec3<S>::Zero();   ///< rad/s, world frame
+  // --- derived from the state (recomputed by updateDerived) ----------------------------------
+  Mat3<S> rotation = Mat3<S>::Identity();
+  Mat3<S> invInertiaWorld = Mat3<S>::Zero();
+
+  /// Rotation matrix and world inverse inertia R diag(I^-1) R^T from the orientation.
+  void updateDerived() {
+    rotation = orientation.toRotationMatrix();
+    invInertiaWorld = rotation * invInertiaLocal.asDiagonal() * rotation.transpose();
+  }
+  Pose<S> partPose(size_t i) const { return Pose<S>{position + rotation * parts[i].offset, rotation}; }
+};
+
+/// Builds a body from its scenario description. Mass properties are exact fractions, rounded
+/// once into S: the thesis formulas (sphere 2/5 m r^2, box m/12 (dy^2 + dz^2), ...); a compound's
+/// mass split over its parts by volume (pi as 355/113, only in that ratio); the parallel-axis
+/// theorem. A compound's principal axes are taken to be the body axes (true for the symmetric
+/// layouts in scenarios/; off-diagonal products of inertia are dropped). `path` names the body
+/// in errors (ScenarioError when a value cannot be combined exactly).
+template <class S>
+RigidBody<S> makeBody(const BodySpec& spec, const Rational& timeStep, const std::string& sourceName,
+                      const std::string& path);
+
+/// Normalises a quaternion with the deterministic sqrt (the identity if it is zero).
+template <class S>
+Quat<S> normalizedQuat(const Quat<S>& q);
+
+}  // namespace sg

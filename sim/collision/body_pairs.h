@@ -1,0 +1,96 @@
+// Body-body broad phase (thesis: all pairs, only three bodies) and the narrow-phase dispatch over
+// compound parts. "brute" tests every pair i < j; "sap" sorts bounding intervals along x and
+// sweeps. Both return the pairs whose bounding spheres overlap, sorted (i, j): identical lists.
+#pragma once
+
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+#include "sim/bodies/rigid_body.h"
+#include "sim/collision/box_box.h"
+#include "sim/collision/primitives.h"
+
+namespace sg {
+
+template <class S>
+bool boundingSpheresOverlap(const RigidBody<S>& a, const RigidBody<S>& b) {
+  const Vec3<S> d = a.position - b.position;
+  const S reach = a.boundingRadius + b.boundingRadius;
+  if (abs(d.x()) > reach || abs(d.y()) > reach || abs(d.z()) > reach) return false;
+  return length3(d.x(), d.y(), d.z()) <= reach;
+}
+
+template <class S>
+std::vector<std::pair<int32_t, int32_t>> bodyPairs(const std::vector<RigidBody<S>>& bodies, BodyBroadphase kind) {
+  std::vector<std::pair<int32_t, int32_t>> pairs;
+  const int32_t n = int32_t(bodies.size());
+  if (kind == BodyBroadphase::Brute) {
+    for (int32_t i = 0; i < n; ++i)
+      for (int32_t j = i + 1; j < n; ++j)
+        if (boundingSpheresOverlap(bodies[size_t(i)], bodies[size_t(j)])) pairs.emplace_back(i, j);
+    return pairs;
+  }
+  // Sweep and prune along x: order by interval start (id breaks ties), scan forward while the
+  // next interval starts before this one ends.
+  std::vector<int32_t> order(static_cast<size_t>(n));
+  for (int32_t i = 0; i < n; ++i) order[size_t(i)] = i;
+  auto lo = [&](int32_t i) { return bodies[size_t(i)].position.x() - bodies[size_t(i)].boundingRadius; };
+  auto hi = [&](int32_t i) { return bodies[size_t(i)].position.x() + bodies[size_t(i)].boundingRadius; };
+  std::stable_sort(order.begin(), order.end(), [&](int32_t a, int32_t b) { return lo(a) < lo(b); });
+  for (size_t x = 0; x < order.size(); ++x)
+    for (size_t y = x + 1; y < order.size() && !(lo(order[y]) > hi(order[x])); ++y) {
+      const int32_t i = std::min(order[x], order[y]), j = std::max(order[x], order[y]);
+      if (boundingSpheresOverlap(bodies[size_t(i)], bodies[size_t(j)])) pairs.emplace_back(i, j);
+    }
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+/// Contacts between bodies i < j over all their parts; features carry the part index in the
+/// upper 16 bits. Every contact has bodyA = i, bodyB = j.
+template <class S>
+void collideBodies(int32_t i, const RigidBody<S>& A, int32_t j, const RigidBody<S>& B, std::vector<Contact<S>>& out) {
+  for (size_t pi = 0; pi < A.parts.size(); ++pi)
+    for (size_t pj = 0; pj < B.parts.size(); ++pj) {
+      const BodyPart<S>& a = A.parts[pi];
+      const BodyPart<S>& b = B.parts[pj];
+      const Pose<S> pa = A.partPose(pi), pb = B.partPose(pj);
+      const size_t first = out.size();
+      if (a.type == ShapeType::Sphere && b.type == ShapeType::Sphere) {
+        collideSphereSphere(i, pa.position, a.radius, j, pb.position, b.radius, out);
+      } else if (a.type == ShapeType::Sphere) {
+        collideSphereBox(i, pa.position, a.radius, j, b.halfExtents, pb, out);
+      } else if (b.type == ShapeType::Sphere) {
+        // Box A, sphere B: solve as sphere-box with the roles swapped, then swap back.
+        collideSphereBox(j, pb.position, b.radius, i, a.halfExtents, pa, out);
+        for (size_t k = first; k < out.size(); ++k) {
+          std::swap(out[k].bodyA, out[k].bodyB);
+          std::swap(out[k].featureA, out[k].featureB);
+          out[k].normal = -out[k].normal;
+        }
+      } else {
+        collideBoxBox(i, a.halfExtents, pa, j, b.halfExtents, pb, out);
+      }
+      for (size_t k = first; k < out.size(); ++k) {
+        out[k].featureA |= uint32_t(pi) << 16;
+        out[k].featureB |= uint32_t(pj) << 16;
+      }
+    }
+}
+
+/// Contacts of body i with the terrain over all its parts.
+template <class S>
+void collideBodyTerrain(int32_t i, const RigidBody<S>& A, const Terrain<S>& terrain, std::vector<Contact<S>>& out) {
+  for (size_t p = 0; p < A.parts.size(); ++p) {
+    const size_t first = out.size();
+    const Pose<S> pose = A.partPose(p);
+    if (A.parts[p].type == ShapeType::Sphere)
+      collideSphereTerrain(i, pose.position, A.parts[p].radius, terrain, out);
+    else
+      collideBoxTerrain(i, A.parts[p].halfExtents, pose, terrain, out);
+    for (size_t k = first; k < out.size(); ++k) out[k].featureA |= uint32_t(p) << 16;
+  }
+}
+
+}  // namespace sg

@@ -1,0 +1,218 @@
+#include "sim/collision/contact_solver.h"
+
+#include <algorithm>
+
+#include "sim/math/scalar_ops.h"
+
+namespace sg {
+namespace {
+
+template <class S>
+struct VelocityRow {
+  Vec3<S> rA, rB;         // contact point relative to the centres of mass
+  Vec3<S> normal, t1, t2;
+  S massN{}, massT1{}, massT2{};  // 1 / effective mass along each direction
+  S target{};             // desired separating normal velocity
+  S friction{};
+  S impulseN{}, impulseT1{}, impulseT2{};  // accumulated
+  int32_t a = 0, b = kTerrainBody;
+};
+
+/// A unit vector orthogonal to n, chosen by a fixed rule (no trigonometry).
+template <class S>
+Vec3<S> tangentOf(const Vec3<S>& n) {
+  const Vec3<S> axis = abs(n.x()) < S(1) / S(2) ? Vec3<S>::UnitX() : Vec3<S>::UnitY();
+  const Vec3<S> t = n.cross(axis);
+  return t / length3(t.x(), t.y(), t.z());
+}
+
+template <class S>
+S inverseMassAlong(const RigidBody<S>& body, const Vec3<S>& r, const Vec3<S>& dir) {
+  const Vec3<S> rxd = r.cross(dir);
+  return body.invMass + (body.invInertiaWorld * rxd).cross(r).dot(dir);
+}
+
+template <class S>
+Vec3<S> velocityAt(const RigidBody<S>& body, const Vec3<S>& r) {
+  return body.velocity + body.angularVelocity.cross(r);
+}
+
+template <class S>
+void applyImpulse(RigidBody<S>& body, const Vec3<S>& r, const Vec3<S>& impulse) {
+  body.velocity += impulse * body.invMass;
+  body.angularVelocity += body.invInertiaWorld * r.cross(impulse);
+}
+
+template <class S>
+Vec3<S> relativeVelocity(const std::vector<RigidBody<S>>& bodies, const VelocityRow<S>& row) {
+  Vec3<S> v = velocityAt(bodies[size_t(row.a)], row.rA);
+  if (row.b != kTerrainBody) v -= velocityAt(bodies[size_t(row.b)], row.rB);
+  return v;
+}
+
+template <class S>
+void applyPair(std::vector<RigidBody<S>>& bodies, const VelocityRow<S>& row, const Vec3<S>& impulse) {
+  applyImpulse(bodies[size_t(row.a)], row.rA, impulse);
+  if (row.b != kTerrainBody) applyImpulse(bodies[size_t(row.b)], row.rB, Vec3<S>(-impulse));
+}
+
+/// 1 / k, or 0 when k is not positive (an immovable direction).
+template <class S>
+S invertPositive(S k) { return k > S(0) ? S(1) / k : S(0); }
+
+}  // namespace
+
+template <class S>
+void sortContacts(std::vector<Contact<S>>& contacts) {
+  std::stable_sort(contacts.begin(), contacts.end(), [](const Contact<S>& x, const Contact<S>& y) {
+    if (x.bodyA != y.bodyA) return x.bodyA < y.bodyA;
+    if (x.bodyB != y.bodyB) return x.bodyB < y.bodyB;
+    if (x.featureA != y.featureA) return x.featureA < y.featureA;
+    return x.featureB < y.featureB;
+  });
+}
+
+template <class S>
+void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
+                            const SolverSettings<S>& settings) {
+  using std::sqrt;
+  std::vector<VelocityRow<S>> rows(contacts.size());
+  for (size_t i = 0; i < contacts.size(); ++i) {
+    const Contact<S>& c = contacts[i];
+    VelocityRow<S>& row = rows[i];
+    row.a = c.bodyA;
+    row.b = c.bodyB;
+    const RigidBody<S>& A = bodies[size_t(c.bodyA)];
+    row.rA = c.point - A.position;
+    row.normal = c.normal;
+    row.t1 = tangentOf(c.normal);
+    row.t2 = c.normal.cross(row.t1);
+    S kN = inverseMassAlong(A, row.rA, row.normal);
+    S kT1 = inverseMassAlong(A, row.rA, row.t1);
+    S kT2 = inverseMassAlong(A, row.rA, row.t2);
+    S restitution = A.restitution, friction = A.friction;
+    if (c.bodyB != kTerrainBody) {
+      const RigidBody<S>& B = bodies[size_t(c.bodyB)];
+      row.rB = c.point - B.position;
+      kN += inverseMassAlong(B, row.rB, row.normal);
+      kT1 += inverseMassAlong(B, row.rB, row.t1);
+      kT2 += inverseMassAlong(B, row.rB, row.t2);
+      restitution = A.restitution < B.restitution ? B.restitution : A.restitution;
+      friction = sqrt(A.friction * B.friction);
+    }
+    row.massN = invertPositive(kN);
+    row.massT1 = invertPositive(kT1);
+    row.massT2 = invertPositive(kT2);
+    row.friction = friction;
+    const S vn = relativeVelocity(bodies, row).dot(row.normal);
+    row.target = vn < -settings.restitutionThreshold ? -restitution * vn : S(0);
+  }
+  for (int it = 0; it < settings.velocityIterations; ++it) {
+    for (VelocityRow<S>& row : rows) {
+      // Normal: push apart until the separating velocity reaches the target; never pull.
+      const S vn = relativeVelocity(bodies, row).dot(row.normal);
+      S lambda = (row.target - vn) * row.massN;
+      const S total = maxS(row.impulseN + lambda, S(0));
+      lambda = total - row.impulseN;
+      row.impulseN = total;
+      applyPair(bodies, row, Vec3<S>(row.normal * lambda));
+      // Friction: stop the sliding velocity, within the Coulomb cone mu * normal impulse.
+      const S limit = row.friction * row.impulseN;
+      for (int t = 0; t < 2; ++t) {
+        const Vec3<S>& dir = t == 0 ? row.t1 : row.t2;
+        S& accumulated = t == 0 ? row.impulseT1 : row.impulseT2;
+        const S vt = relativeVelocity(bodies, row).dot(dir);
+        const S wanted = accumulated - vt * (t == 0 ? row.massT1 : row.massT2);
+        const S clamped = wanted < -limit ? -limit : (wanted > limit ? limit : wanted);
+        const S delta = clamped - accumulated;
+        accumulated = clamped;
+        applyPair(bodies, row, Vec3<S>(dir * delta));
+      }
+    }
+  }
+}
+
+template <class S>
+void solveContactPositions(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
+                           const SolverSettings<S>& settings) {
+  const size_t n = contacts.size();
+  if (n == 0) return;
+  std::vector<S> depth(n);
+  std::vector<Vec3<S>> rA(n), rB(n);
+  for (size_t i = 0; i < n; ++i) {
+    depth[i] = contacts[i].penetration;
+    rA[i] = contacts[i].point - bodies[size_t(contacts[i].bodyA)].position;
+    if (contacts[i].bodyB != kTerrainBody) rB[i] = contacts[i].point - bodies[size_t(contacts[i].bodyB)].position;
+  }
+  const size_t iterations = size_t(settings.positionIterationsPerContact) * n;
+  for (size_t it = 0; it < iterations; ++it) {
+    // The deepest contact first (lowest index on ties: canonical order).
+    size_t worst = n;
+    S deepest = settings.linearSlop;
+    for (size_t i = 0; i < n; ++i)
+      if (depth[i] > deepest) {
+        deepest = depth[i];
+        worst = i;
+      }
+    if (worst == n) break;
+    const Contact<S>& c = contacts[worst];
+    const Vec3<S>& normal = c.normal;
+    // Leave `linearSlop` of overlap (Box2D): the contact then still exists next tick, so a resting
+    // body keeps its support instead of falling g dt^2 and being pushed back every other tick.
+    deepest -= settings.linearSlop;
+    const int32_t ids[2] = {c.bodyA, c.bodyB};
+    const Vec3<S>* arms[2] = {&rA[worst], &rB[worst]};
+    S linearInertia[2] = {S(0), S(0)}, angularInertia[2] = {S(0), S(0)};
+    Vec3<S> angularPerUnit[2] = {Vec3<S>::Zero(), Vec3<S>::Zero()};
+    S totalInertia(0);
+    for (int k = 0; k < 2; ++k) {
+      if (ids[k] == kTerrainBody) continue;
+      const RigidBody<S>& body = bodies[size_t(ids[k])];
+      angularPerUnit[k] = body.invInertiaWorld * arms[k]->cross(normal);
+      angularInertia[k] = angularPerUnit[k].cross(*arms[k]).dot(normal);
+      linearInertia[k] = body.invMass;
+      totalInertia += linearInertia[k] + angularInertia[k];
+    }
+    if (!(totalInertia > S(0))) {
+      depth[worst] = S(0);
+      continue;
+    }
+    for (int k = 0; k < 2; ++k) {
+      if (ids[k] == kTerrainBody) continue;
+      RigidBody<S>& body = bodies[size_t(ids[k])];
+      const S sign = k == 0 ? S(1) : S(-1);
+      S linearMove = sign * deepest * linearInertia[k] / totalInertia;
+      S angularMove = sign * deepest * angularInertia[k] / totalInertia;
+      // Cyclone: rotating by more than 0.2 |r| per step overshoots; move linearly instead.
+      const S limit = arms[k]->norm() / S(5);
+      if (abs(angularMove) > limit) {
+        const S both = linearMove + angularMove;
+        angularMove = angularMove < S(0) ? -limit : limit;
+        linearMove = both - angularMove;
+      }
+      const Vec3<S> dp = normal * linearMove;
+      const Vec3<S> dTheta = angularInertia[k] > S(0) ? Vec3<S>(angularPerUnit[k] * (angularMove / angularInertia[k]))
+                                                     : Vec3<S>(Vec3<S>::Zero());
+      body.position += dp;
+      const Quat<S> spin(S(0), dTheta.x(), dTheta.y(), dTheta.z());
+      Quat<S> q = body.orientation;
+      q.coeffs() += (spin * body.orientation).coeffs() / S(2);
+      body.orientation = normalizedQuat(q);
+      body.updateDerived();
+      // Every contact of this body loses (or gains) the depth this move removed.
+      for (size_t i = 0; i < n; ++i) {
+        if (contacts[i].bodyA == ids[k]) depth[i] -= (dp + dTheta.cross(rA[i])).dot(contacts[i].normal);
+        if (contacts[i].bodyB == ids[k]) depth[i] += (dp + dTheta.cross(rB[i])).dot(contacts[i].normal);
+      }
+    }
+  }
+}
+
+#define SG_INSTANTIATE(S)                                                                                           \
+  template void sortContacts(std::vector<Contact<S>>&);                                                             \
+  template void solveContactVelocities(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&,                 \
+                                       const SolverSettings<S>&);                                                   \
+  template void solveContactPositions(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&, const SolverSettings<S>&);
+SG_FOR_EACH_SCALAR(SG_INSTANTIATE)
+#undef SG_INSTANTIATE
+}  // namespace sg

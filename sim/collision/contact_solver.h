@@ -1,0 +1,43 @@
+// Collision response for rigid bodies (thesis §7, Cyclone):
+//   1. velocities: sequential impulses over all contacts, `velocityIterations` sweeps. Normal
+//      impulses are accumulated and kept >= 0, the separating-velocity target is -e v_n
+//      (restitution) for approaches faster than `restitutionThreshold`, else 0 (resting contact);
+//      Coulomb friction on two tangents, accumulated and clamped to mu * normal impulse (the
+//      thesis leaves friction out; a testbed needs it).
+//   2. positions: Cyclone's non-linear projection, down to `linearSlop` of overlap (so resting
+//      contacts persist from tick to tick). Repeatedly take the deepest contact, move both
+//      bodies linearly and angularly in proportion to their inverse mass and inverse angular
+//      inertia about the contact, limit the angular part to 0.2 |r| per step, and update the
+//      penetration of every other contact of the moved bodies.
+// Contacts are sorted canonically (bodies, then features) before solving, so the result never
+// depends on how the narrow phase found them.
+#pragma once
+
+#include <vector>
+
+#include "sim/bodies/rigid_body.h"
+#include "sim/collision/contact.h"
+
+namespace sg {
+
+template <class S>
+struct SolverSettings {
+  int velocityIterations = 8;
+  int positionIterationsPerContact = 2;
+  S restitutionThreshold{};  ///< m/s
+  S linearSlop{};            ///< m: penetration the position pass leaves alone
+};
+
+/// Sorts contacts into their canonical order (bodyA, bodyB, featureA, featureB).
+template <class S>
+void sortContacts(std::vector<Contact<S>>& contacts);
+
+template <class S>
+void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
+                            const SolverSettings<S>& settings);
+
+template <class S>
+void solveContactPositions(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
+                           const SolverSettings<S>& settings);
+
+}  // namespace sg

@@ -1,0 +1,286 @@
+// Rigid bodies against analytic solutions, broad-phase bit-identity, and robustness.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tests/test_support.h"
+
+namespace sg {
+namespace {
+
+template <class S>
+double d(S v) { return ScalarTraits<S>::toDouble(v); }
+
+Rational3 r3(int64_t x, int64_t y, int64_t z, int64_t den = 1) {
+  return {*Rational::make(x, den), *Rational::make(y, den), *Rational::make(z, den)};
+}
+
+/// A tiny meadow far from the bodies (bodies are what these tests look at).
+Scenario emptyWorld() {
+  Scenario s = test::thesisMeadow();
+  s.field.patchesX = s.field.patchesZ = 2;
+  s.field.centerX = Rational{-500, 1};
+  s.wind.schedule.clear();
+  return s;
+}
+
+BodySpec sphere(const char* name, Rational radius, Rational3 position) {
+  BodySpec b;
+  b.name = name;
+  ShapeSpec p;
+  p.type = ShapeType::Sphere;
+  p.radius = radius;
+  b.parts = {p};
+  b.position = position;
+  return b;
+}
+
+using test::makeTyped;
+
+template <class S>
+void run(World<S>& w, const Scenario& s, int64_t ticks) {
+  for (int64_t t = 0; t < ticks; ++t) ASSERT_TRUE(w.step(scriptedInput(s, w.tick())).ok) << "tick " << w.tick();
+}
+
+// ---- free fall and projectile: semi-implicit Euler against the analytic solution -------------
+// v_n = v0 + g n dt, y_n = y0 + v0 t + g dt^2 n (n + 1) / 2 = exact + g dt t / 2: the error is
+// exactly g dt t / 2 (first order), which halves when dt halves.
+double freeFallError(const Rational& dt, double seconds) {
+  Scenario s = emptyWorld();
+  s.timeStep = dt;
+  s.bodies.list = {sphere("ball", Rational{1, 2}, r3(0, 1000, 0))};
+  s.bodies.list[0].velocity = r3(3, 4, 0);
+  auto w = makeTyped<double>(s);
+  const int64_t n = std::llround(seconds / dt.toDouble());
+  run(*w, s, n);
+  const double t = double(n) * dt.toDouble();
+  const auto& b = w->bodies()[0];
+  EXPECT_NEAR(b.position.x(), 3 * t, 1e-9) << "no horizontal force: x is exact";
+  const double exact = 1000 + 4 * t - 0.5 * 9.81 * t * t;
+  return b.position.y() - exact;
+}
+
+TEST(Bodies, FreeFallErrorIsFirstOrderAsDerived) {
+  const double e60 = freeFallError(Rational{1, 60}, 2.0), e120 = freeFallError(Rational{1, 120}, 2.0);
+  EXPECT_NEAR(e60, -9.81 / 60 * 2.0 / 2, 1e-9);  // -g dt t / 2 (falls slightly ahead)
+  EXPECT_NEAR(e120, -9.81 / 120 * 2.0 / 2, 1e-9);
+  EXPECT_NEAR(e60 / e120, 2.0, 1e-6);
+}
+
+TEST(Bodies, Fx32FreeFallMatchesDouble) {
+  Scenario s = emptyWorld();
+  s.bodies.list = {sphere("ball", Rational{1, 2}, r3(0, 1000, 0))};
+  auto wf = makeTyped<Fx32>(s);
+  auto wd = makeTyped<double>(s);
+  run(*wf, s, 120);
+  run(*wd, s, 120);
+  // dt = 1/60 rounds to Q32.32 with relative error <= 2^-33 * 60, which scales the whole fall
+  // (19.8 m); each tick adds at most 2^-32 of product rounding to y (and to v, felt over dt).
+  const double fallen = 1000.0 - wd->bodies()[0].position.y();
+  const double bound = fallen * std::ldexp(60.0, -33) + 120 * std::ldexp(1.0, -32) * 2;
+  EXPECT_NEAR(d(wf->bodies()[0].position.y()), wd->bodies()[0].position.y(), bound);
+}
+
+// ---- bounce: apex heights shrink by e^2 ------------------------------------------------------------
+TEST(Bodies, BounceApexRatioIsRestitutionSquared) {
+  Scenario s = emptyWorld();
+  s.timeStep = Rational{1, 240};
+  s.bodies.list = {sphere("ball", Rational{1, 10}, r3(0, 21, 0, 10))};  // drop from 2.1 m (2 m of fall)
+  s.bodies.list[0].restitution = Rational{1, 2};
+  auto w = makeTyped<double>(s);
+  std::vector<double> apex;
+  double prevV = 0;
+  for (int t = 0; t < 240 * 6 && apex.size() < 3; ++t) {
+    ASSERT_TRUE(w->step(TickInput{}).ok);
+    const auto& b = w->bodies()[0];
+    if (prevV > 0 && b.velocity.y() <= 0) apex.push_back(b.position.y() - 0.1);
+    prevV = b.velocity.y();
+  }
+  ASSERT_GE(apex.size(), 2u);
+  // Height 2 m, then 0.5 m, then 0.125 m. The impact is resolved on the tick the ball touches, so
+  // up to one tick of motion (v dt = 6.3 m/s / 240 = 2.6 cm) is lost or gained per impact: 3 %.
+  EXPECT_NEAR(apex[0] / 2.0, 0.25, 0.03) << apex[0];
+  EXPECT_NEAR(apex[1] / apex[0], 0.25, 0.03) << apex[1];
+}
+
+// ---- a sphere at rest stays at rest -----------------------------------------------------------------
+template <class S>
+void expectRestingSphereStill() {
+  Scenario s = emptyWorld();
+  s.bodies.list = {sphere("ball", Rational{3, 10}, r3(0, 3, 0, 10))};
+  auto w = makeTyped<S>(s);
+  run(*w, s, 120);
+  const double y0 = d(w->bodies()[0].position.y());
+  double lo = y0, hi = y0;
+  for (int t = 0; t < 600; ++t) {
+    ASSERT_TRUE(w->step(TickInput{}).ok);
+    lo = std::min(lo, d(w->bodies()[0].position.y()));
+    hi = std::max(hi, d(w->bodies()[0].position.y()));
+  }
+  // Gravity adds g dt^2 = 2.7 mm of sink per tick at most before the projection; the slop is 0.5 mm.
+  EXPECT_LT(hi - lo, 0.003);
+  EXPECT_NEAR(y0, 0.3, 0.003);
+}
+TEST(Bodies, RestingSphereStaysPutFx32) { expectRestingSphereStill<Fx32>(); }
+TEST(Bodies, RestingSphereStaysPutDouble) { expectRestingSphereStill<double>(); }
+
+// ---- slopes -------------------------------------------------------------------------------------------
+/// An exact plane rising along +x with slope 1/4: samples 15 x (x = 0..16, 1 m apart, the map
+/// centred at 0) and maxHeight 17/4 m give h = (x + 8) / 4 exactly, i.e. h(0) = 2.
+Scenario slope() {
+  Scenario s = emptyWorld();
+  s.terrain.flat = false;
+  s.terrain.cellSize = Rational{1, 1};
+  s.terrain.maxHeight = Rational{17, 4};
+  s.terrain.heightmap.width = 17;
+  s.terrain.heightmap.height = 3;
+  for (int z = 0; z < 3; ++z)
+    for (int x = 0; x < 17; ++x) s.terrain.heightmap.samples.push_back(uint8_t(15 * x));
+  return s;
+}
+
+TEST(Bodies, SphereRollingDownAnInclineReachesRollingSpeed) {
+  // tan(theta) = 4/16: a rolling sphere needs mu >= 2/7 tan(theta) = 0.07; mu = 1.
+  Scenario s = slope();
+  s.timeStep = Rational{1, 240};
+  s.bodies.list = {sphere("ball", Rational{1, 2}, r3(6, 0, 0))};
+  s.bodies.list[0].friction = Rational{1, 1};
+  s.bodies.list[0].restitution = Rational{0, 1};
+  auto w = makeTyped<double>(s);
+  auto& b = w->mutableBodies()[0];
+  const double n = std::sqrt(1 + 0.0625);
+  b.position.y() = (6 + 8) * 0.25 + 0.5 * n;  // on the plane: centre r / cos(theta) above it
+  const double y0 = b.position.y();
+  for (int t = 0; t < 240 * 3; ++t) ASSERT_TRUE(w->step(TickInput{}).ok);
+  const double h = y0 - b.position.y();
+  ASSERT_GT(h, 0.3) << "it should have rolled down";
+  const double expected = std::sqrt(10.0 / 7.0 * 9.81 * h);
+  // Rolling without slipping: v = sqrt(10/7 g h); sliding without friction would give sqrt(2 g h)
+  // (18 % faster). 4 % covers the first-order integration error at dt = 1/240.
+  EXPECT_NEAR(b.velocity.norm() / expected, 1.0, 0.04) << "h " << h;
+}
+
+TEST(Bodies, FxSphereOnIncline) {
+  Scenario s = slope();
+  s.bodies.list = {sphere("ball", Rational{1, 2}, r3(6, 4, 0))};
+  s.bodies.list[0].friction = Rational{1, 1};
+  auto w = makeTyped<Fx32>(s);
+  run(*w, s, 300);
+  EXPECT_LT(d(w->bodies()[0].position.x()), 5.0) << "rolls down (towards -x)";
+  EXPECT_EQ(takeFixedFaults(), 0u);
+}
+
+// ---- grass -----------------------------------------------------------------------------------------------
+Scenario thesisBodies(const char* scalar) {
+  Scenario s = loadScenarioFile(test::sourcePath("scenarios/thesis-bodies.json"));
+  s.scalar = *parseScalarKind(scalar);
+  return s;
+}
+
+TEST(Bodies, SphereAt50MetresPerSecondThroughTheMeadow) {
+  for (const char* scalar : {"fx32", "fx16", "double"}) {
+    Scenario s = test::thesisMeadow();
+    s.scalar = *parseScalarKind(scalar);
+    BodySpec ball = sphere("bullet", Rational{1, 2}, r3(-18, 1, 0, 1));
+    ball.velocity = r3(50, 0, 0);
+    s.bodies.gravity = r3(0, 0, 0);
+    s.bodies.list = {ball};
+    validateForScalar(s, s.scalar, 0);
+    auto w = makeWorld(s, 2);
+    for (int t = 0; t < 60; ++t) ASSERT_TRUE(w->step(TickInput{}).ok) << scalar << " tick " << t;
+    dispatchScalar(s.scalar, [&]<class S>() {
+      const auto& world = dynamic_cast<const World<S>&>(*w);
+      const auto& p = world.particles();
+      double worst = 0;
+      for (size_t i = 0; i < p.px.size(); ++i) {
+        const double dx = d(p.px[i] - p.anchorX[i]), dy = d(p.py[i] - p.anchorY[i]), dz = d(p.pz[i] - p.anchorZ[i]);
+        ASSERT_TRUE(std::isfinite(dx + dy + dz));
+        worst = std::max(worst, std::fabs(std::sqrt(dx * dx + dy * dy + dz * dz) - 1.0));
+      }
+      EXPECT_LT(worst, 1e-3) << scalar << ": every particle within its constraint";
+      EXPECT_GT(d(world.bodies()[0].position.x()), 20.0) << "passed through";
+    });
+  }
+}
+
+// Every broad-phase variant gives the bit-identical state (the broad phase only prunes).
+TEST(Bodies, BroadPhasesAreBitIdentical) {
+  for (const char* scalar : {"fx32", "fx16"}) {
+    std::vector<uint64_t> hashes;
+    for (auto particles : {ParticleBroadphase::Grid, ParticleBroadphase::Brute})
+      for (auto pairs : {BodyBroadphase::Brute, BodyBroadphase::SweepAndPrune}) {
+        Scenario s = thesisBodies(scalar);
+        s.bodies.particleBroadphase = particles;
+        s.bodies.bodyBroadphase = pairs;
+        auto w = makeWorld(s, 2);
+        int64_t pushedTicks = 0;
+        for (int t = 0; t < 480; ++t) {
+          ASSERT_TRUE(w->step(scriptedInput(s, w->tick())).ok) << scalar << " tick " << t;
+          pushedTicks += w->counts().contacts > 0;
+        }
+        EXPECT_GT(pushedTicks, 100) << "bodies rest on the ground: contacts every tick";
+        hashes.push_back(w->stateHash());
+      }
+    for (size_t i = 1; i < hashes.size(); ++i) EXPECT_EQ(hashes[i], hashes[0]) << scalar << " variant " << i;
+  }
+}
+
+TEST(Bodies, BodiesBendTheGrass) {
+  Scenario s = thesisBodies("fx32");
+  s.wind.schedule.clear();
+  auto w = std::make_unique<World<Fx32>>(s, 1);
+  int maxTilt = 0;
+  for (int t = 0; t < 240; ++t) {
+    ASSERT_TRUE(w->step(scriptedInput(s, w->tick())).ok);
+    for (uint8_t level : w->patches().tiltLevel) maxTilt = std::max<int>(maxTilt, level);
+  }
+  EXPECT_EQ(maxTilt, 3) << "tufts under the bodies are pressed flat";
+}
+
+TEST(Bodies, SaveRestoreWithBodiesContinuesBitExactly) {
+  Scenario s = thesisBodies("fx32");
+  auto a = makeWorld(s, 1);
+  for (int t = 0; t < 250; ++t) ASSERT_TRUE(a->step(scriptedInput(s, a->tick())).ok);
+  const auto saved = a->saveState();
+  auto b = makeWorld(s, 2);
+  b->restoreState(saved);
+  for (int t = 0; t < 250; ++t) {
+    ASSERT_TRUE(a->step(scriptedInput(s, a->tick())).ok);
+    ASSERT_TRUE(b->step(scriptedInput(s, b->tick())).ok);
+  }
+  EXPECT_EQ(a->stateHash(), b->stateHash());
+}
+
+TEST(Bodies, DegenerateStartsStayFinite) {
+  Scenario s = test::thesisMeadow();
+  s.field.patchesX = s.field.patchesZ = 9;
+  s.field.spacing = Rational{1, 2};
+  // Two spheres at the same point, one under the ground, a particle exactly at a sphere centre.
+  s.bodies.list = {sphere("a", Rational{1, 2}, r3(0, 1, 0)), sphere("b", Rational{1, 2}, r3(0, 1, 0)),
+                   sphere("c", Rational{1, 2}, r3(1, -1, 1))};
+  for (const char* scalar : {"fx32", "fx16", "float"}) {
+    s.scalar = *parseScalarKind(scalar);
+    auto w = makeWorld(s, 1);
+    dispatchScalar(s.scalar, [&]<class S>() {
+      auto& world = dynamic_cast<World<S>&>(*w);
+      auto& p = world.mutableParticles();
+      p.px[40] = world.bodies()[0].position.x();
+      p.py[40] = world.bodies()[0].position.y();
+      p.pz[40] = world.bodies()[0].position.z();
+    });
+    for (int t = 0; t < 120; ++t) ASSERT_TRUE(w->step(TickInput{}).ok) << scalar << " tick " << t;
+    dispatchScalar(s.scalar, [&]<class S>() {
+      const auto& world = dynamic_cast<const World<S>&>(*w);
+      for (const auto& b : world.bodies()) {
+        EXPECT_GT(d(b.position.y()), 0.45) << scalar << ": out of the ground";
+        EXPECT_TRUE(std::isfinite(d(b.position.x())));
+      }
+      const auto& a = world.bodies()[0].position;
+      const auto& b = world.bodies()[1].position;
+      EXPECT_GT(std::hypot(d(a.x() - b.x()), d(a.y() - b.y()), d(a.z() - b.z())), 0.9) << scalar << ": separated";
+    });
+  }
+}
+
+}  // namespace
+}  // namespace sg
