@@ -61,7 +61,8 @@ INSTANTIATE_TEST_SUITE_P(
     ScenariosScalarsThreads, GoldenHash,
     ::testing::Combine(::testing::Values(GoldenCase{"thesis-meadow", "fx32"}, GoldenCase{"thesis-meadow", "fx16"},
                                          GoldenCase{"hilly-meadow", "fx32"}, GoldenCase{"hilly-meadow", "fx16"},
-                                         GoldenCase{"thesis-bodies", "fx32"}, GoldenCase{"thesis-bodies", "fx16"}),
+                                         GoldenCase{"thesis-bodies", "fx32"}, GoldenCase{"thesis-bodies", "fx16"},
+                                         GoldenCase{"mower-field", "fx32"}, GoldenCase{"mower-field", "fx16"}),
                        ::testing::Values(1, 2, 4)),
     [](const auto& info) {
       const GoldenCase& c = std::get<0>(info.param);
@@ -91,7 +92,8 @@ TEST_P(SaveRestore, RestoreAtTick300ContinuesToTheGoldenHash) {
 INSTANTIATE_TEST_SUITE_P(Goldens, SaveRestore,
                          ::testing::Values(GoldenCase{"thesis-meadow", "fx32"}, GoldenCase{"thesis-meadow", "fx16"},
                                            GoldenCase{"hilly-meadow", "fx32"}, GoldenCase{"hilly-meadow", "fx16"},
-                                           GoldenCase{"thesis-bodies", "fx32"}, GoldenCase{"thesis-bodies", "fx16"}),
+                                           GoldenCase{"thesis-bodies", "fx32"}, GoldenCase{"thesis-bodies", "fx16"},
+                                         GoldenCase{"mower-field", "fx32"}, GoldenCase{"mower-field", "fx16"}),
                          [](const auto& info) {
                            std::string n = info.param.scenario + "_" + info.param.scalar;
                            for (char& ch : n) if (ch == '-') ch = '_';

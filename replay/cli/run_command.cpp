@@ -21,6 +21,8 @@ struct RunOptions {
   int interp = 0;
   int threads = 1;
   int64_t hashEvery = 0;
+  std::string broadphase;      // particles vs bodies: grid | brute
+  std::string bodyBroadphase;  // bodies vs bodies: brute | sap
   bool json = false;
 };
 
@@ -37,6 +39,10 @@ int runScenario(const RunOptions& o) {
     scenario = loadScenarioFile(o.scenario);
     if (!o.scalar.empty()) scenario.scalar = *parseScalarKind(o.scalar);
     if (o.interp > 0) scenario.particles.interpolation = o.interp;
+    if (!o.broadphase.empty())
+      scenario.bodies.particleBroadphase = o.broadphase == "brute" ? ParticleBroadphase::Brute : ParticleBroadphase::Grid;
+    if (!o.bodyBroadphase.empty())
+      scenario.bodies.bodyBroadphase = o.bodyBroadphase == "sap" ? BodyBroadphase::SweepAndPrune : BodyBroadphase::Brute;
     world = makeWorld(scenario, o.threads, physicalMemoryBytes());
   } catch (const ScenarioError& e) {
     std::fprintf(stderr, "simgrass run: %s\n", e.what());
@@ -136,6 +142,10 @@ void addRunCommand(CLI::App& app, int* exitCode) {
       ->check(CLI::Range(1, 256));
   run->add_option("--hash-every", opts->hashEvery, "Also print the state hash every N ticks")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
+  run->add_option("--broadphase", opts->broadphase, "Particle-vs-body broad phase (the state is identical)")
+      ->check(CLI::IsMember({"grid", "brute"}));
+  run->add_option("--body-broadphase", opts->bodyBroadphase, "Body-vs-body broad phase (the state is identical)")
+      ->check(CLI::IsMember({"brute", "sap"}));
   run->add_flag("--json", opts->json, "Machine-readable output");
   run->callback([opts, exitCode] { *exitCode = runScenario(*opts); });
 }

@@ -43,7 +43,8 @@ struct PatchArrays {
   // static
   std::vector<S> rootX, rootY, rootZ;  ///< tuft root on the ground (m)
   std::vector<uint16_t> rotation;      ///< fraction of a turn, /65536
-  std::vector<uint8_t> variant;        ///< atlas tuft variant
+  std::vector<uint8_t> variant;        ///< atlas tuft variant; == atlasVariants: the white marking tuft
+  std::vector<uint8_t> cut;            ///< 1 once a mower has cut the tuft (persistent world state)
   // derived (thesis §9.2.6)
   std::vector<S> tipOffsetX, tipOffsetZ;  ///< top-vertex x/z shift from the root (m)
   std::vector<S> topY;                    ///< top-vertex height: root + scaleY - smaller (m)

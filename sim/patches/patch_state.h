@@ -23,6 +23,8 @@ struct PatchStateConstants {
   int k = 1;
   std::vector<S> weight;  ///< weight[t] = t / k, t = 0..k-1
   S rodLength{}, halfRod{}, scaleY{};
+  S cutReduction{};  ///< scaleYMinus of a mown tuft: scaleY - mowerCutHeight (>= 0)
+  S minimumTop{};    ///< a tuft never gets shorter than this (m)
   S drop[3]{};
 };
 
@@ -45,7 +47,9 @@ inline void writePatch(PatchArrays<S>& patches, size_t p, S ddx, S ddy, S ddz, c
   patches.tipOffsetZ[p] = ddz;
   const S sink = zero - ddy;
   const S smaller = sink < zero ? zero : (sink > c.halfRod ? c.halfRod : sink);
-  patches.topY[p] = patches.rootY[p] + c.scaleY - smaller;
+  // Thesis: top = root + scaleY - scaleYMinus - smaller; scaleYMinus is set by the mower.
+  const S top = c.scaleY - smaller - (patches.cut[p] ? c.cutReduction : zero);
+  patches.topY[p] = patches.rootY[p] + (top < c.minimumTop ? c.minimumTop : top);
   patches.tiltLevel[p] = uint8_t(sink > c.drop[2] ? 3 : sink > c.drop[1] ? 2 : sink > c.drop[0] ? 1 : 0);
 }
 

@@ -139,8 +139,17 @@ struct Scenario {
     ParticleBroadphase particleBroadphase = ParticleBroadphase::Grid;
     BodyBroadphase bodyBroadphase = BodyBroadphase::Brute;
     BoxParticleNormal boxParticleNormal = BoxParticleNormal::Up;
+    Rational mowerCutHeight{1, 5};  ///< m above the ground: where a mower's blade cuts the tufts
     std::vector<BodySpec> list;
   } bodies;
+
+  /// A football field painted with white tufts (thesis §5): lines of `lineWidth` along the
+  /// boundary, the halfway line and the centre circle; length along x, width along z.
+  struct Markings {
+    bool enabled = false;
+    Rational centerX{0, 1}, centerZ{0, 1};
+    Rational length{30, 1}, width{20, 1}, lineWidth{1, 2}, centerCircleRadius{3, 1};
+  } markings;
   std::vector<ScriptedCommand> script;  ///< sorted by tick, then body
 
   std::string sourceName = "<built-in>";  ///< file name for error messages

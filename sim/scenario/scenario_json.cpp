@@ -366,7 +366,8 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
 void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
   const std::string p = "$.bodies";
   r.object(j, p, {"gravity", "velocityIterations", "positionIterations", "particleBroadphase", "bodyBroadphase",
-                  "boxParticleNormal", "list"});
+                  "boxParticleNormal", "mowerCutHeight", "list"});
+  if (j.contains("mowerCutHeight")) b.mowerCutHeight = r.nonNegative(j["mowerCutHeight"], p + ".mowerCutHeight");
   if (j.contains("gravity")) b.gravity = r.vector<3>(j["gravity"], p + ".gravity");
   if (j.contains("velocityIterations"))
     b.velocityIterations = int(r.integer(j["velocityIterations"], p + ".velocityIterations", 1, 1000));
@@ -391,6 +392,21 @@ void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
         if (b.list[k].name == b.list.back().name) r.fail(q + ".name", "a unique body name, '" + b.list.back().name + "' is taken");
     }
   }
+}
+
+void parseMarkings(const Reader& r, const json& j, Scenario::Markings& m) {
+  const std::string p = "$.markings";
+  r.object(j, p, {"center", "length", "width", "lineWidth", "centerCircleRadius"});
+  m.enabled = true;
+  if (j.contains("center")) {
+    auto c = r.vector<2>(j["center"], p + ".center");
+    m.centerX = c[0];
+    m.centerZ = c[1];
+  }
+  if (j.contains("length")) m.length = r.positive(j["length"], p + ".length");
+  if (j.contains("width")) m.width = r.positive(j["width"], p + ".width");
+  if (j.contains("lineWidth")) m.lineWidth = r.positive(j["lineWidth"], p + ".lineWidth");
+  if (j.contains("centerCircleRadius")) m.centerCircleRadius = r.nonNegative(j["centerCircleRadius"], p + ".centerCircleRadius");
 }
 
 void parseScript(const Reader& r, const json& j, Scenario& s) {
@@ -486,7 +502,7 @@ Scenario parseScenario(const std::string& text, const std::string& sourceName, c
   s.sourceName = sourceName;
   s.text = text;
   r.object(root, "$", {"format", "name", "description", "seed", "scalar", "timeStep", "field", "particles", "wind", "terrain",
-                       "bodies", "script"});
+                       "bodies", "script", "markings"});
   if (root.contains("format") && root["format"] != "simgrass-scenario/1")
     r.failGot("$.format", "\"simgrass-scenario/1\"", root["format"]);
   if (root.contains("name")) s.name = r.string(root["name"], "$.name");
@@ -511,6 +527,7 @@ Scenario parseScenario(const std::string& text, const std::string& sourceName, c
   if (root.contains("terrain")) parseTerrain(r, root["terrain"], s.terrain, readFile);
   if (root.contains("bodies")) parseBodies(r, root["bodies"], s.bodies);
   if (root.contains("script")) parseScript(r, root["script"], s);
+  if (root.contains("markings")) parseMarkings(r, root["markings"], s.markings);
   if (s.wind.schedule.empty()) {
     // An empty schedule is allowed: no wind.
   }

@@ -131,6 +131,19 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   patchConsts_.rodLength = particleConsts_.rodLength;
   patchConsts_.halfRod = toS<S>(c.halfRod);
   patchConsts_.scaleY = toS<S>(f.scaleY);
+  mowerCutHeight_ = toS<S>(s.bodies.mowerCutHeight);
+  patchConsts_.cutReduction = maxS(patchConsts_.scaleY - mowerCutHeight_, S(0));
+  patchConsts_.minimumTop = patchConsts_.scaleY / S(10);
+  if (s.markings.enabled) {
+    const auto& m = s.markings;
+    markings_.enabled = true;
+    markings_.centerX = toS<S>(m.centerX);
+    markings_.centerZ = toS<S>(m.centerZ);
+    markings_.halfLength = toS<S>(m.length) / S(2);
+    markings_.halfWidth = toS<S>(m.width) / S(2);
+    markings_.halfLine = toS<S>(m.lineWidth) / S(2);
+    markings_.circleRadius = toS<S>(m.centerCircleRadius);
+  }
   for (int i = 0; i < 3; ++i) patchConsts_.drop[i] = toS<S>(s.particles.tiltDrop[size_t(i)]);
 
   for (const auto& force : c.gustForcePerMass) {
@@ -173,6 +186,7 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
     v->assign(nPatches, S(0));
   patches_.rotation.assign(nPatches, 0);
   patches_.variant.assign(nPatches, 0);
+  patches_.cut.assign(nPatches, 0);
   patches_.tiltLevel.assign(nPatches, 0);
   const int64_t patchRowsPerChunk = std::max<int64_t>(1, kTargetChunkElements / f.patchesX);
   pool_->run((f.patchesZ + patchRowsPerChunk - 1) / patchRowsPerChunk, [&](int64_t c, int) {
@@ -184,6 +198,9 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
         patches_.rootY[p] = terrain_.heightAt(patches_.rootX[p], patches_.rootZ[p]);
         patches_.rotation[p] = lattice_.rotation(i, j);
         patches_.variant[p] = lattice_.variant(i, j);
+        // Markings use the un-jittered lattice point: straight lines despite the jitter.
+        if (markings_.onLine(lattice_.originX + mulInt(lattice_.spacing, i), lattice_.originZ + mulInt(lattice_.spacing, j)))
+          patches_.variant[p] = uint8_t(lattice_.atlasVariants);
       }
   });
 
@@ -334,11 +351,50 @@ bool World<S>::bodiesFaulted(Stage stage) {
 }
 
 template <class S>
+void World<S>::mowGrass() {
+  // A mower part cuts every tuft whose point at the blade height (root + mowerCutHeight) lies
+  // inside it. Cuts are keyed by lattice coordinates and never undone.
+  const S invSpacing = S(1) / lattice_.spacing;
+  for (const RigidBody<S>& body : bodies_) {
+    if (!body.mower) continue;
+    for (size_t part = 0; part < body.parts.size(); ++part) {
+      const BodyPart<S>& shape = body.parts[part];
+      const Pose<S> pose = body.partPose(part);
+      const S reach = shape.boundingRadius + lattice_.jitterAmplitude + lattice_.spacing;
+      const int64_t i0 = std::max<int64_t>(0, floorToInt((pose.position.x() - reach - lattice_.originX) * invSpacing));
+      const int64_t i1 = std::min<int64_t>(lattice_.patchesX - 1, floorToInt((pose.position.x() + reach - lattice_.originX) * invSpacing) + 1);
+      const int64_t j0 = std::max<int64_t>(0, floorToInt((pose.position.z() - reach - lattice_.originZ) * invSpacing));
+      const int64_t j1 = std::min<int64_t>(lattice_.patchesZ - 1, floorToInt((pose.position.z() + reach - lattice_.originZ) * invSpacing) + 1);
+      for (int64_t j = j0; j <= j1; ++j)
+        for (int64_t i = i0; i <= i1; ++i) {
+          const size_t p = size_t(j * lattice_.patchesX + i);
+          if (patches_.cut[p]) continue;
+          const Vec3<S> blade(patches_.rootX[p], patches_.rootY[p] + mowerCutHeight_, patches_.rootZ[p]);
+          bool inside;
+          if (shape.type == ShapeType::Sphere) {
+            const Vec3<S> d = blade - pose.position;
+            inside = abs(d.x()) < shape.radius && abs(d.y()) < shape.radius && abs(d.z()) < shape.radius &&
+                     length3(d.x(), d.y(), d.z()) < shape.radius;
+          } else {
+            const Vec3<S> local = pose.toLocal(blade);
+            inside = abs(local.x()) < shape.halfExtents.x() && abs(local.y()) < shape.halfExtents.y() &&
+                     abs(local.z()) < shape.halfExtents.z();
+          }
+          if (!inside) continue;
+          patches_.cut[p] = 1;
+          cuts_.emplace(std::make_pair(i, j), uint8_t(1));
+        }
+    }
+  }
+}
+
+template <class S>
 bool World<S>::respondToContacts() {
   applyGravity(bodies_, gravityDt_);
   solveContactVelocities(bodies_, contacts_, solver_);
   solveContactPositions(bodies_, contacts_, solver_);
   if (bodiesFaulted(Stage::Response)) return false;
+  mowGrass();
   // Grass: pushed out of every body (particle rows in parallel, bodies in id order).
   const std::vector<ParticleRange> ranges = particleRanges(bodies_, grid_, bodyParticle_);
   return runParticleRows(Stage::Response, [&](int64_t row, int64_t, int64_t) {
@@ -442,8 +498,13 @@ void World<S>::serialise(StateSink& sink) const {
                           b.angularVelocity.x(), b.angularVelocity.y(), b.angularVelocity.z()};
     sink.write(values, sizeof values);
   }
-  const uint64_t edits = 0;
+  // Persistent patch edits: mown patches (i, j), in key order.
+  const uint64_t edits = cuts_.size();
   sink.write(&edits, sizeof edits);
+  for (const auto& [key, value] : cuts_) {
+    const int64_t ij[2] = {key.first, key.second};
+    sink.write(ij, sizeof ij);
+  }
 }
 
 template <class S>
@@ -486,12 +547,27 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   std::memcpy(&count, bytes.data() + 32, 8);
   if (tick < 0) throw StateError(24, "a non-negative tick");
   if (count != int64_t(n)) throw StateError(32, std::to_string(n) + " particles, got " + std::to_string(count));
-  if (bytes.size() != expectedSize)
-    throw StateError(std::min(bytes.size(), expectedSize), std::to_string(expectedSize) + " bytes of state, got " +
-                                                               std::to_string(bytes.size()));
+  if (bytes.size() < expectedSize)
+    throw StateError(bytes.size(), std::to_string(expectedSize) + " bytes of state, got " + std::to_string(bytes.size()));
   uint64_t edits;
   std::memcpy(&edits, bytes.data() + expectedSize - 8, 8);
-  if (edits != 0) throw StateError(expectedSize - 8, "0 persistent patch edits in a state of format version 1");
+  if (edits > uint64_t(lattice_.patchesX * lattice_.patchesZ))
+    throw StateError(expectedSize - 8, "at most one edit per patch, got " + std::to_string(edits));
+  const size_t totalSize = expectedSize + size_t(edits) * 16;
+  if (bytes.size() != totalSize)
+    throw StateError(std::min(bytes.size(), totalSize), std::to_string(totalSize) + " bytes of state, got " +
+                                                            std::to_string(bytes.size()));
+  std::map<std::pair<int64_t, int64_t>, uint8_t> cuts;
+  for (uint64_t e = 0; e < edits; ++e) {
+    int64_t ij[2];
+    const size_t at = expectedSize + size_t(e) * 16;
+    std::memcpy(ij, bytes.data() + at, 16);
+    if (ij[0] < 0 || ij[1] < 0 || ij[0] >= lattice_.patchesX || ij[1] >= lattice_.patchesZ)
+      throw StateError(at, "a patch inside the field");
+    if (!cuts.empty() && !(cuts.rbegin()->first < std::make_pair(ij[0], ij[1])))
+      throw StateError(at, "patch edits in increasing (i, j) order");
+    cuts.emplace(std::make_pair(ij[0], ij[1]), uint8_t(1));
+  }
   const uint8_t* src = bytes.data() + kStateHeaderBytes;
   for (auto* v : {&particles_.px, &particles_.py, &particles_.pz, &particles_.vx, &particles_.vy, &particles_.vz}) {
     std::memcpy(v->data(), src, n * sizeof(S));
@@ -507,6 +583,9 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
     b.angularVelocity = Vec3<S>(v[10], v[11], v[12]);
     b.updateDerived();
   }
+  cuts_ = std::move(cuts);
+  std::fill(patches_.cut.begin(), patches_.cut.end(), uint8_t(0));
+  for (const auto& [key, value] : cuts_) patches_.cut[size_t(key.second * lattice_.patchesX + key.first)] = 1;
   tick_ = tick;
   failed_ = false;
   failure_ = SimError{};

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -19,6 +20,7 @@
 #include "sim/collision/body_particles.h"
 #include "sim/collision/contact_solver.h"
 #include "sim/field/grass_field.h"
+#include "sim/field/markings.h"
 #include "sim/particles/particles.h"
 #include "sim/patches/patch_state.h"
 #include "sim/scenario/scenario.h"
@@ -112,6 +114,7 @@ class World final : public SimWorld {
   const std::vector<RigidBody<S>>& bodies() const { return bodies_; }
   std::vector<RigidBody<S>>& mutableBodies() { return bodies_; }  ///< tests: set up states
   const std::vector<Contact<S>>& contacts() const { return contacts_; }  ///< last tick's
+  const std::map<std::pair<int64_t, int64_t>, uint8_t>& cuts() const { return cuts_; }
   const ParticleConstants<S>& particleConstants() const { return particleConsts_; }
   /// Recomputes the derived patch state from the particles (done by step and restore).
   void updatePatchState();
@@ -123,6 +126,7 @@ class World final : public SimWorld {
   void detectContacts();
   bool respondToContacts();
   bool bodiesFaulted(Stage stage);
+  void mowGrass();
   void serialise(class StateSink& sink) const;
 
   uint64_t configHash_ = 0;
@@ -138,6 +142,10 @@ class World final : public SimWorld {
   WindConstants<S> windConsts_;
   RowAccelerationDt<S> rowAccel_;
   std::vector<RigidBody<S>> bodies_;
+  /// Mown patches by lattice coordinates (i, j): persistent, ordered, saved and hashed.
+  std::map<std::pair<int64_t, int64_t>, uint8_t> cuts_;
+  S mowerCutHeight_{};
+  FieldMarkings<S> markings_;
   std::vector<Contact<S>> contacts_;
   SolverSettings<S> solver_;
   BodyParticleSettings<S> bodyParticle_;
