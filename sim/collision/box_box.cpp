@@ -99,8 +99,6 @@ struct Axis {
   S pen{};         ///< overlap of the two boxes along the unit axis (m)
 };
 
-inline bool isFaceA(int index) { return index < 3; }
-
 /// The edge-pair axis L = a_i x b_j in A's frame, not normalised (|L| = sin of the angle).
 template <class S>
 struct EdgeAxis {

@@ -73,8 +73,20 @@ void sortContacts(std::vector<Contact<S>>& contacts) {
 }
 
 template <class S>
+bool keyLess(const CachedImpulse<S>& x, const Contact<S>& y) {
+  if (x.bodyA != y.bodyA) return x.bodyA < y.bodyA;
+  if (x.bodyB != y.bodyB) return x.bodyB < y.bodyB;
+  if (x.featureA != y.featureA) return x.featureA < y.featureA;
+  return x.featureB < y.featureB;
+}
+template <class S>
+bool sameKey(const CachedImpulse<S>& x, const Contact<S>& y) {
+  return x.bodyA == y.bodyA && x.bodyB == y.bodyB && x.featureA == y.featureA && x.featureB == y.featureB;
+}
+
+template <class S>
 void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
-                            const SolverSettings<S>& settings) {
+                            const SolverSettings<S>& settings, std::vector<CachedImpulse<S>>& cache) {
   using std::sqrt;
   std::vector<VelocityRow<S>> rows(contacts.size());
   for (size_t i = 0; i < contacts.size(); ++i) {
@@ -106,6 +118,16 @@ void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector
     row.friction = friction;
     const S vn = relativeVelocity(bodies, row).dot(row.normal);
     row.target = vn < -settings.restitutionThreshold ? -restitution * vn : S(0);
+    // Warm start: the same contact (bodies and features) last tick starts from its impulses.
+    auto hit = std::lower_bound(cache.begin(), cache.end(), c, [](const CachedImpulse<S>& x, const Contact<S>& y) {
+      return keyLess(x, y);
+    });
+    if (hit != cache.end() && sameKey(*hit, c)) {
+      row.impulseN = hit->normal;
+      row.impulseT1 = hit->tangent1;
+      row.impulseT2 = hit->tangent2;
+      applyPair(bodies, row, Vec3<S>(row.normal * row.impulseN + row.t1 * row.impulseT1 + row.t2 * row.impulseT2));
+    }
   }
   for (int it = 0; it < settings.velocityIterations; ++it) {
     for (VelocityRow<S>& row : rows) {
@@ -130,6 +152,10 @@ void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector
       }
     }
   }
+  cache.clear();
+  for (size_t i = 0; i < rows.size(); ++i)
+    cache.push_back(CachedImpulse<S>{contacts[i].bodyA, contacts[i].bodyB, contacts[i].featureA, contacts[i].featureB,
+                                     rows[i].impulseN, rows[i].impulseT1, rows[i].impulseT2});
 }
 
 template <class S>
@@ -211,7 +237,7 @@ void solveContactPositions(std::vector<RigidBody<S>>& bodies, const std::vector<
 #define SG_INSTANTIATE(S)                                                                                           \
   template void sortContacts(std::vector<Contact<S>>&);                                                             \
   template void solveContactVelocities(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&,                 \
-                                       const SolverSettings<S>&);                                                   \
+                                       const SolverSettings<S>&, std::vector<CachedImpulse<S>>&);                   \
   template void solveContactPositions(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&, const SolverSettings<S>&);
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE)
 #undef SG_INSTANTIATE

@@ -32,9 +32,23 @@ struct SolverSettings {
 template <class S>
 void sortContacts(std::vector<Contact<S>>& contacts);
 
+/// The accumulated impulses of one contact at the end of a tick, keyed by its canonical identity
+/// (bodies and features). The next tick starts from them (warm starting, as Box2D and Jolt do):
+/// without it, sequential impulses need many more iterations and a stack leans and falls.
+/// Part of the world state (saved, restored, hashed).
+template <class S>
+struct CachedImpulse {
+  int32_t bodyA = 0, bodyB = kTerrainBody;
+  uint32_t featureA = 0, featureB = 0;
+  S normal{}, tangent1{}, tangent2{};
+  friend bool operator==(const CachedImpulse&, const CachedImpulse&) = default;
+};
+
+/// Solves velocities; `cache` holds last tick's impulses (sorted by key) and is replaced by this
+/// tick's.
 template <class S>
 void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
-                            const SolverSettings<S>& settings);
+                            const SolverSettings<S>& settings, std::vector<CachedImpulse<S>>& cache);
 
 template <class S>
 void solveContactPositions(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,

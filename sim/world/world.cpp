@@ -391,7 +391,7 @@ void World<S>::mowGrass() {
 template <class S>
 bool World<S>::respondToContacts() {
   applyGravity(bodies_, gravityDt_);
-  solveContactVelocities(bodies_, contacts_, solver_);
+  solveContactVelocities(bodies_, contacts_, solver_, impulseCache_);
   solveContactPositions(bodies_, contacts_, solver_);
   if (bodiesFaulted(Stage::Response)) return false;
   mowGrass();
@@ -498,6 +498,18 @@ void World<S>::serialise(StateSink& sink) const {
                           b.angularVelocity.x(), b.angularVelocity.y(), b.angularVelocity.z()};
     sink.write(values, sizeof values);
   }
+  if (!bodies_.empty()) {  // warm-start impulses: they shape the next tick, so they are state
+    const uint64_t cached = impulseCache_.size();
+    sink.write(&cached, sizeof cached);
+    for (const CachedImpulse<S>& c : impulseCache_) {
+      const int32_t ids[2] = {c.bodyA, c.bodyB};
+      const uint32_t features[2] = {c.featureA, c.featureB};
+      const S impulses[3] = {c.normal, c.tangent1, c.tangent2};
+      sink.write(ids, sizeof ids);
+      sink.write(features, sizeof features);
+      sink.write(impulses, sizeof impulses);
+    }
+  }
   // Persistent patch edits: mown patches (i, j), in key order.
   const uint64_t edits = cuts_.size();
   sink.write(&edits, sizeof edits);
@@ -526,7 +538,7 @@ template <class S>
 void World<S>::restoreState(std::span<const uint8_t> bytes) {
   const size_t n = size_t(grid_.size());
   const size_t bodyBytes = bodies_.size() * 13 * sizeof(S);
-  const size_t expectedSize = kStateHeaderBytes + 6 * n * sizeof(S) + bodyBytes + 8;
+  const size_t expectedSize = kStateHeaderBytes + 6 * n * sizeof(S) + bodyBytes + 8;  // minimum
   if (bytes.size() < kStateHeaderBytes) throw StateError(bytes.size(), "a 40-byte state header (the data ends early)");
   if (std::memcmp(bytes.data(), kStateMagic, 8) != 0) throw StateError(0, "the state magic 'SGSTATE1'");
   uint32_t version;
@@ -547,20 +559,49 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   std::memcpy(&count, bytes.data() + 32, 8);
   if (tick < 0) throw StateError(24, "a non-negative tick");
   if (count != int64_t(n)) throw StateError(32, std::to_string(n) + " particles, got " + std::to_string(count));
-  if (bytes.size() < expectedSize)
-    throw StateError(bytes.size(), std::to_string(expectedSize) + " bytes of state, got " + std::to_string(bytes.size()));
+  // Warm-start cache (only with bodies): count, then (ids, features, 3 impulses) per entry.
+  const size_t cacheAt = kStateHeaderBytes + 6 * n * sizeof(S) + bodyBytes;
+  const size_t entryBytes = 16 + 3 * sizeof(S);
+  std::vector<CachedImpulse<S>> cache;
+  size_t editsAt = cacheAt;
+  if (!bodies_.empty()) {
+    if (bytes.size() < cacheAt + 8) throw StateError(bytes.size(), "the contact-impulse count (the data ends early)");
+    uint64_t cached;
+    std::memcpy(&cached, bytes.data() + cacheAt, 8);
+    if (cached > (bytes.size() - cacheAt - 8) / entryBytes)
+      throw StateError(cacheAt, "a contact-impulse count that fits the data, got " + std::to_string(cached));
+    for (uint64_t e = 0; e < cached; ++e) {
+      const size_t at = cacheAt + 8 + size_t(e) * entryBytes;
+      CachedImpulse<S> c;
+      int32_t ids[2];
+      uint32_t features[2];
+      S impulses[3];
+      std::memcpy(ids, bytes.data() + at, 8);
+      std::memcpy(features, bytes.data() + at + 8, 8);
+      std::memcpy(impulses, bytes.data() + at + 16, sizeof impulses);
+      const int32_t nb = int32_t(bodies_.size());
+      if (ids[0] < 0 || ids[0] >= nb || ids[1] < kTerrainBody || ids[1] >= nb)
+        throw StateError(at, "contact bodies between -1 and " + std::to_string(nb - 1));
+      c = CachedImpulse<S>{ids[0], ids[1], features[0], features[1], impulses[0], impulses[1], impulses[2]};
+      cache.push_back(c);
+    }
+    editsAt = cacheAt + 8 + size_t(cached) * entryBytes;
+  }
+  const size_t fixedSize = editsAt + 8;
+  if (bytes.size() < fixedSize)
+    throw StateError(bytes.size(), std::to_string(fixedSize) + " bytes of state, got " + std::to_string(bytes.size()));
   uint64_t edits;
-  std::memcpy(&edits, bytes.data() + expectedSize - 8, 8);
+  std::memcpy(&edits, bytes.data() + editsAt, 8);
   if (edits > uint64_t(lattice_.patchesX * lattice_.patchesZ))
-    throw StateError(expectedSize - 8, "at most one edit per patch, got " + std::to_string(edits));
-  const size_t totalSize = expectedSize + size_t(edits) * 16;
+    throw StateError(editsAt, "at most one edit per patch, got " + std::to_string(edits));
+  const size_t totalSize = fixedSize + size_t(edits) * 16;
   if (bytes.size() != totalSize)
     throw StateError(std::min(bytes.size(), totalSize), std::to_string(totalSize) + " bytes of state, got " +
                                                             std::to_string(bytes.size()));
   std::map<std::pair<int64_t, int64_t>, uint8_t> cuts;
   for (uint64_t e = 0; e < edits; ++e) {
     int64_t ij[2];
-    const size_t at = expectedSize + size_t(e) * 16;
+    const size_t at = fixedSize + size_t(e) * 16;
     std::memcpy(ij, bytes.data() + at, 16);
     if (ij[0] < 0 || ij[1] < 0 || ij[0] >= lattice_.patchesX || ij[1] >= lattice_.patchesZ)
       throw StateError(at, "a patch inside the field");
@@ -584,6 +625,7 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
     b.updateDerived();
   }
   cuts_ = std::move(cuts);
+  impulseCache_ = std::move(cache);
   std::fill(patches_.cut.begin(), patches_.cut.end(), uint8_t(0));
   for (const auto& [key, value] : cuts_) patches_.cut[size_t(key.second * lattice_.patchesX + key.first)] = 1;
   tick_ = tick;

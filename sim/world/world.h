@@ -147,6 +147,7 @@ class World final : public SimWorld {
   S mowerCutHeight_{};
   FieldMarkings<S> markings_;
   std::vector<Contact<S>> contacts_;
+  std::vector<CachedImpulse<S>> impulseCache_;  ///< warm-start impulses (state)
   SolverSettings<S> solver_;
   BodyParticleSettings<S> bodyParticle_;
   BodyBroadphase bodyBroadphase_ = BodyBroadphase::Brute;
