@@ -118,16 +118,48 @@ void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector
     row.friction = friction;
     const S vn = relativeVelocity(bodies, row).dot(row.normal);
     row.target = vn < -settings.restitutionThreshold ? -restitution * vn : S(0);
-    // Warm start: the same contact (bodies and features) last tick starts from its impulses.
-    auto hit = std::lower_bound(cache.begin(), cache.end(), c, [](const CachedImpulse<S>& x, const Contact<S>& y) {
-      return keyLess(x, y);
-    });
-    if (hit != cache.end() && sameKey(*hit, c)) {
-      row.impulseN = hit->normal;
-      row.impulseT1 = hit->tangent1;
-      row.impulseT2 = hit->tangent2;
-      applyPair(bodies, row, Vec3<S>(row.normal * row.impulseN + row.t1 * row.impulseT1 + row.t2 * row.impulseT2));
+  }
+  // Warm start, in two passes so every cached entry serves at most one contact: first the
+  // contacts whose key (bodies and features) is unchanged, then the others by nearest point.
+  std::vector<uint8_t> used(cache.size(), 0);
+  std::vector<size_t> match(rows.size(), cache.size());
+  for (size_t i = 0; i < rows.size(); ++i) {
+    auto hit = std::lower_bound(cache.begin(), cache.end(), contacts[i],
+                                [](const CachedImpulse<S>& x, const Contact<S>& y) { return keyLess(x, y); });
+    if (hit != cache.end() && sameKey(*hit, contacts[i])) {
+      match[i] = size_t(hit - cache.begin());
+      used[match[i]] = 1;
     }
+  }
+  const S tolerance = S(1) / S(100);  // 1 cm
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (match[i] != cache.size()) continue;
+    const Contact<S>& c = contacts[i];
+    auto first = std::lower_bound(cache.begin(), cache.end(), c, [](const CachedImpulse<S>& x, const Contact<S>& y) {
+      return x.bodyA != y.bodyA ? x.bodyA < y.bodyA : x.bodyB < y.bodyB;
+    });
+    S best = tolerance * tolerance;
+    for (auto it = first; it != cache.end() && it->bodyA == c.bodyA && it->bodyB == c.bodyB; ++it) {
+      const size_t k = size_t(it - cache.begin());
+      if (used[k]) continue;
+      const Vec3<S> d = it->point - c.point;
+      if (abs(d.x()) >= tolerance || abs(d.y()) >= tolerance || abs(d.z()) >= tolerance) continue;
+      const S d2 = d.squaredNorm();
+      if (d2 < best) {
+        best = d2;
+        match[i] = k;
+      }
+    }
+    if (match[i] != cache.size()) used[match[i]] = 1;
+  }
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (match[i] == cache.size()) continue;
+    VelocityRow<S>& row = rows[i];
+    const CachedImpulse<S>& hit = cache[match[i]];
+    row.impulseN = hit.normal;
+    row.impulseT1 = hit.tangent1;
+    row.impulseT2 = hit.tangent2;
+    applyPair(bodies, row, Vec3<S>(row.normal * row.impulseN + row.t1 * row.impulseT1 + row.t2 * row.impulseT2));
   }
   for (int it = 0; it < settings.velocityIterations; ++it) {
     for (VelocityRow<S>& row : rows) {
@@ -155,7 +187,7 @@ void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector
   cache.clear();
   for (size_t i = 0; i < rows.size(); ++i)
     cache.push_back(CachedImpulse<S>{contacts[i].bodyA, contacts[i].bodyB, contacts[i].featureA, contacts[i].featureB,
-                                     rows[i].impulseN, rows[i].impulseT1, rows[i].impulseT2});
+                                     rows[i].impulseN, rows[i].impulseT1, rows[i].impulseT2, contacts[i].point});
 }
 
 template <class S>

@@ -41,11 +41,15 @@ struct CachedImpulse {
   int32_t bodyA = 0, bodyB = kTerrainBody;
   uint32_t featureA = 0, featureB = 0;
   S normal{}, tangent1{}, tangent2{};
+  Vec3<S> point = Vec3<S>::Zero();  ///< world contact point, for matching when features change
   friend bool operator==(const CachedImpulse&, const CachedImpulse&) = default;
 };
 
 /// Solves velocities; `cache` holds last tick's impulses (sorted by key) and is replaced by this
-/// tick's.
+/// tick's. A contact takes the cached impulses of the same key, or else of the nearest cached
+/// contact point of the same body pair within 1 cm: two coplanar box faces swap clipping
+/// features from tick to tick (a corner exactly on a side plane), and losing their impulses makes
+/// a stack walk.
 template <class S>
 void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
                             const SolverSettings<S>& settings, std::vector<CachedImpulse<S>>& cache);

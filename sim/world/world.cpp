@@ -504,7 +504,7 @@ void World<S>::serialise(StateSink& sink) const {
     for (const CachedImpulse<S>& c : impulseCache_) {
       const int32_t ids[2] = {c.bodyA, c.bodyB};
       const uint32_t features[2] = {c.featureA, c.featureB};
-      const S impulses[3] = {c.normal, c.tangent1, c.tangent2};
+      const S impulses[6] = {c.normal, c.tangent1, c.tangent2, c.point.x(), c.point.y(), c.point.z()};
       sink.write(ids, sizeof ids);
       sink.write(features, sizeof features);
       sink.write(impulses, sizeof impulses);
@@ -561,7 +561,7 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   if (count != int64_t(n)) throw StateError(32, std::to_string(n) + " particles, got " + std::to_string(count));
   // Warm-start cache (only with bodies): count, then (ids, features, 3 impulses) per entry.
   const size_t cacheAt = kStateHeaderBytes + 6 * n * sizeof(S) + bodyBytes;
-  const size_t entryBytes = 16 + 3 * sizeof(S);
+  const size_t entryBytes = 16 + 6 * sizeof(S);
   std::vector<CachedImpulse<S>> cache;
   size_t editsAt = cacheAt;
   if (!bodies_.empty()) {
@@ -575,14 +575,15 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
       CachedImpulse<S> c;
       int32_t ids[2];
       uint32_t features[2];
-      S impulses[3];
+      S impulses[6];
       std::memcpy(ids, bytes.data() + at, 8);
       std::memcpy(features, bytes.data() + at + 8, 8);
       std::memcpy(impulses, bytes.data() + at + 16, sizeof impulses);
       const int32_t nb = int32_t(bodies_.size());
       if (ids[0] < 0 || ids[0] >= nb || ids[1] < kTerrainBody || ids[1] >= nb)
         throw StateError(at, "contact bodies between -1 and " + std::to_string(nb - 1));
-      c = CachedImpulse<S>{ids[0], ids[1], features[0], features[1], impulses[0], impulses[1], impulses[2]};
+      c = CachedImpulse<S>{ids[0], ids[1], features[0], features[1], impulses[0], impulses[1], impulses[2],
+                           Vec3<S>(impulses[3], impulses[4], impulses[5])};
       cache.push_back(c);
     }
     editsAt = cacheAt + 8 + size_t(cached) * entryBytes;
