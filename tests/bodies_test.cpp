@@ -206,6 +206,39 @@ TEST(Bodies, BoxDoesNotSinkThroughARidgeBetweenItsCorners) {
   }
 }
 
+// Sleeping: still bodies fall asleep after 0.5 s (30 ticks) and stop integrating; a command or
+// an awake body touching them wakes them; the sleep state is saved like any other state.
+TEST(Bodies, SleepWakeAndRestore) {
+  Scenario s = emptyWorld();
+  s.bodies.list = {sphere("resting", Rational{3, 10}, r3(0, 3, 0, 10)), sphere("dropped", Rational{3, 10}, r3(0, 3, 0))};
+  s.bodies.list[1].position = r3(1, 3, 0);  // falls next to the first, not on it
+  s.script = {ScriptedCommand{200, 0, BodyCommandKind::AddVelocity, r3(1, 0, 0)}};
+  auto w = makeTyped<Fx32>(s);
+  run(*w, s, 150);
+  EXPECT_TRUE(w->bodies()[0].asleep) << "still for > 0.5 s";
+  EXPECT_TRUE(w->bodies()[1].asleep) << "landed and settled";
+  const auto frozen = w->bodies()[0].position;
+  run(*w, s, 40);
+  EXPECT_EQ(w->bodies()[0].position, frozen) << "a sleeping body does not integrate";
+  // Save while asleep, restore, and continue: the command at tick 200 wakes body 0 in both.
+  const auto saved = w->saveState();
+  auto copy = makeTyped<Fx32>(s);
+  copy->restoreState(saved);
+  EXPECT_TRUE(copy->bodies()[0].asleep);
+  run(*w, s, 20);
+  run(*copy, s, 20);
+  EXPECT_FALSE(w->bodies()[0].asleep) << "woken by the command";
+  EXPECT_GT(d(w->bodies()[0].position.x()), d(frozen.x()) + 0.05);
+  EXPECT_EQ(w->stateHash(), copy->stateHash());
+  // Rolling into the sleeping second body wakes it.
+  bool woke = false;
+  for (int t = 0; t < 120 && !woke; ++t) {
+    ASSERT_TRUE(w->step(scriptedInput(s, w->tick())).ok);
+    woke = !w->bodies()[1].asleep;
+  }
+  EXPECT_TRUE(woke) << "an awake body touching a sleeping one wakes it";
+}
+
 // ---- grass -----------------------------------------------------------------------------------------------
 Scenario thesisBodies(const char* scalar) {
   Scenario s = loadScenarioFile(test::sourcePath("scenarios/thesis-bodies.json"));

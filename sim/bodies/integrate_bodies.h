@@ -13,13 +13,15 @@ namespace sg {
 /// v += g dt for every body.
 template <class S>
 inline void applyGravity(std::vector<RigidBody<S>>& bodies, const Vec3<S>& gravityDt) {
-  for (RigidBody<S>& b : bodies) b.velocity += gravityDt;
+  for (RigidBody<S>& b : bodies)
+    if (!b.asleep) b.velocity += gravityDt;
 }
 
 /// p += v dt; q += dt/2 (0, w) q, renormalised; then v, w *= damping^dt.
 template <class S>
 inline void integrateBodyPositions(std::vector<RigidBody<S>>& bodies, S dt) {
   for (RigidBody<S>& b : bodies) {
+    if (b.asleep) continue;
     b.position += b.velocity * dt;
     const Vec3<S> w = b.angularVelocity * (dt / S(2));
     const Quat<S> spin(S(0), w.x(), w.y(), w.z());
@@ -30,6 +32,29 @@ inline void integrateBodyPositions(std::vector<RigidBody<S>>& bodies, S dt) {
     b.angularVelocity *= b.angularDampingPerTick;
     b.updateDerived();
   }
+}
+
+/// Sleeping (a deterministic rule: integer counters and comparisons only). A body whose speed and
+/// angular speed both stay below the thresholds for `ticksToSleep` consecutive ticks falls asleep
+/// with zero velocities; it wakes when a command moves it or an awake body touches it.
+template <class S>
+inline void updateSleep(std::vector<RigidBody<S>>& bodies, S linearThreshold, S angularThreshold, int32_t ticksToSleep) {
+  const S lin2 = linearThreshold * linearThreshold, ang2 = angularThreshold * angularThreshold;
+  for (RigidBody<S>& b : bodies) {
+    if (!b.canSleep || b.asleep) continue;
+    const bool still = b.velocity.squaredNorm() < lin2 && b.angularVelocity.squaredNorm() < ang2;
+    b.stillTicks = still ? b.stillTicks + 1 : 0;
+    if (b.stillTicks >= ticksToSleep) {
+      b.asleep = true;
+      b.velocity = Vec3<S>::Zero();
+      b.angularVelocity = Vec3<S>::Zero();
+    }
+  }
+}
+
+inline void wake(auto& body) {
+  body.asleep = false;
+  body.stillTicks = 0;
 }
 
 }  // namespace sg

@@ -87,6 +87,7 @@ RigidBody<S> makeBody(const BodySpec& spec, const Rational& dt, const std::strin
   b.restitution = toS<S>(spec.restitution);
   b.friction = toS<S>(spec.friction);
   b.mower = spec.mower;
+  b.canSleep = spec.canSleep;
   b.position = toS3<S>(spec.position);
   b.orientation = normalizedQuat(Quat<S>(toS<S>(spec.orientation[0]), toS<S>(spec.orientation[1]),
                                          toS<S>(spec.orientation[2]), toS<S>(spec.orientation[3])));

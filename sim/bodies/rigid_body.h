@@ -30,11 +30,14 @@ struct RigidBody {
   S restitution{}, friction{};
   S boundingRadius{};                          ///< m, around the centre of mass: covers every part
   bool mower = false;
+  bool canSleep = true;
   // --- state (saved, hashed) -----------------------------------------------------------------
   Vec3<S> position = Vec3<S>::Zero();          ///< centre of mass (m)
   Quat<S> orientation = Quat<S>::Identity();   ///< unit quaternion, body -> world
   Vec3<S> velocity = Vec3<S>::Zero();          ///< m/s
   Vec3<S> angularVelocity = Vec3<S>::Zero();   ///< rad/s, world frame
+  int32_t stillTicks = 0;                      ///< consecutive ticks below the sleep thresholds
+  bool asleep = false;                         ///< skips gravity and integration until woken
   // --- derived from the state (recomputed by updateDerived) ----------------------------------
   Mat3<S> rotation = Mat3<S>::Identity();
   Mat3<S> invInertiaWorld = Mat3<S>::Zero();

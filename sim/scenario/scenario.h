@@ -62,6 +62,7 @@ struct BodySpec {
   Rational restitution{3, 10};
   Rational friction{1, 2};
   bool mower = false;             ///< cuts the grass it touches
+  bool canSleep = true;           ///< may sleep when it has been still for a while (thesis: "ability to sleep")
 };
 
 /// One scripted command (the scenario's input track).

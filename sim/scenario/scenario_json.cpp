@@ -318,7 +318,7 @@ ShapeSpec parseShapePart(const Reader& r, const json& j, const std::string& p, b
 BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
   BodySpec b;
   r.object(j, p, {"name", "shape", "mass", "position", "orientation", "velocity", "angularVelocity", "linearDamping",
-                  "angularDamping", "restitution", "friction", "mower"});
+                  "angularDamping", "restitution", "friction", "mower", "canSleep"});
   if (!j.contains("name")) r.fail(p + ".name", "a body name (missing)");
   b.name = r.string(j["name"], p + ".name");
   if (!j.contains("shape")) r.fail(p + ".shape", "a shape {\"type\": \"sphere\" | \"box\" | \"compound\", ...} (missing)");
@@ -359,6 +359,10 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
   if (j.contains("mower")) {
     if (!j["mower"].is_boolean()) r.failGot(p + ".mower", "true or false", j["mower"]);
     b.mower = j["mower"].get<bool>();
+  }
+  if (j.contains("canSleep")) {
+    if (!j["canSleep"].is_boolean()) r.failGot(p + ".canSleep", "true or false", j["canSleep"]);
+    b.canSleep = j["canSleep"].get<bool>();
   }
   return b;
 }

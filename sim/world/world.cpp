@@ -77,8 +77,8 @@ uint64_t scenarioFingerprint(const Scenario& s) {
       }
       for (const Rational* r : {&body.mass, &body.linearDamping, &body.angularDamping, &body.restitution, &body.friction})
         hashRational(h, *r);
-      const int64_t mower = body.mower;
-      h.write(&mower, sizeof mower);
+      const int64_t flags = (body.mower ? 1 : 0) | (body.canSleep ? 2 : 0);
+      h.write(&flags, sizeof flags);
     }
   }
   return h.digest();
@@ -169,6 +169,9 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   solver_.restitutionThreshold = S(1);
   solver_.linearSlop = toS<S>(Rational{1, 2000});  // 0.5 mm
   bodyBroadphase_ = s.bodies.bodyBroadphase;
+  sleepLinear_ = toS<S>(Rational{1, 20});   // 5 cm/s
+  sleepAngular_ = toS<S>(Rational{1, 20});  // 0.05 rad/s
+  kTicksToSleep = std::max<int32_t>(1, int32_t(*div(Rational{1, 2}, s.timeStep)->roundToInt64()));  // 0.5 s
   bodyParticle_.boxNormal = s.bodies.boxParticleNormal;
   bodyParticle_.broadphase = s.bodies.particleBroadphase;
   bodyParticle_.particleInvMass = toS<S>(c.invMass);
@@ -304,6 +307,7 @@ void World<S>::applyCommands(const TickInput& input) {
   for (const BodyCommand& cmd : input.bodies) {
     if (cmd.body < 0 || size_t(cmd.body) >= bodies_.size()) continue;  // validated by the reader
     RigidBody<S>& b = bodies_[size_t(cmd.body)];
+    wake(b);
     const Vec3<S> v(ScalarTraits<S>::fromRational(Rational{cmd.value.x, int64_t(1) << 32}).value_or(S(0)),
                     ScalarTraits<S>::fromRational(Rational{cmd.value.y, int64_t(1) << 32}).value_or(S(0)),
                     ScalarTraits<S>::fromRational(Rational{cmd.value.z, int64_t(1) << 32}).value_or(S(0)));
@@ -323,9 +327,21 @@ void World<S>::applyCommands(const TickInput& input) {
 template <class S>
 void World<S>::detectContacts() {
   contacts_.clear();
-  for (const auto& [i, j] : bodyPairs(bodies_, bodyBroadphase_))
-    collideBodies(i, bodies_[size_t(i)], j, bodies_[size_t(j)], contacts_);
-  for (size_t i = 0; i < bodies_.size(); ++i) collideBodyTerrain(int32_t(i), bodies_[i], terrain_, contacts_);
+  // Sleeping bodies keep no contacts among themselves or with the terrain; an awake body that
+  // touches a sleeping one wakes it (pairs in (i, j) order: the same wake-ups for any broad phase).
+  for (const auto& [i, j] : bodyPairs(bodies_, bodyBroadphase_)) {
+    RigidBody<S>& a = bodies_[size_t(i)];
+    RigidBody<S>& b = bodies_[size_t(j)];
+    if (a.asleep && b.asleep) continue;
+    const size_t before = contacts_.size();
+    collideBodies(i, a, j, b, contacts_);
+    if (contacts_.size() > before) {
+      if (a.asleep) wake(a);
+      if (b.asleep) wake(b);
+    }
+  }
+  for (size_t i = 0; i < bodies_.size(); ++i)
+    if (!bodies_[i].asleep) collideBodyTerrain(int32_t(i), bodies_[i], terrain_, contacts_);
   sortContacts(contacts_);
 }
 
@@ -449,6 +465,7 @@ StepResult World<S>::step(const TickInput& input, StageObserver* observer) {
   });
   if (integrated && hasBodies) {
     integrateBodyPositions(bodies_, c.dt);
+    updateSleep(bodies_, sleepLinear_, sleepAngular_, kTicksToSleep);
     if (bodiesFaulted(Stage::Integrate)) return {false, failure_};
   }
   end(Stage::Integrate);
@@ -497,6 +514,8 @@ void World<S>::serialise(StateSink& sink) const {
                           b.orientation.y(), b.orientation.z(), b.velocity.x(), b.velocity.y(), b.velocity.z(),
                           b.angularVelocity.x(), b.angularVelocity.y(), b.angularVelocity.z()};
     sink.write(values, sizeof values);
+    const int32_t sleep[2] = {b.stillTicks, b.asleep ? 1 : 0};
+    sink.write(sleep, sizeof sleep);
   }
   if (!bodies_.empty()) {  // warm-start impulses: they shape the next tick, so they are state
     const uint64_t cached = impulseCache_.size();
@@ -537,7 +556,7 @@ std::vector<uint8_t> World<S>::saveState() const {
 template <class S>
 void World<S>::restoreState(std::span<const uint8_t> bytes) {
   const size_t n = size_t(grid_.size());
-  const size_t bodyBytes = bodies_.size() * 13 * sizeof(S);
+  const size_t bodyBytes = bodies_.size() * (13 * sizeof(S) + 8);
   const size_t expectedSize = kStateHeaderBytes + 6 * n * sizeof(S) + bodyBytes + 8;  // minimum
   if (bytes.size() < kStateHeaderBytes) throw StateError(bytes.size(), "a 40-byte state header (the data ends early)");
   if (std::memcmp(bytes.data(), kStateMagic, 8) != 0) throw StateError(0, "the state magic 'SGSTATE1'");
@@ -623,6 +642,11 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
     b.orientation = Quat<S>(v[3], v[4], v[5], v[6]);
     b.velocity = Vec3<S>(v[7], v[8], v[9]);
     b.angularVelocity = Vec3<S>(v[10], v[11], v[12]);
+    int32_t sleep[2];
+    std::memcpy(sleep, src, sizeof sleep);
+    src += sizeof sleep;
+    b.stillTicks = sleep[0] < 0 ? 0 : sleep[0];
+    b.asleep = sleep[1] != 0;
     b.updateDerived();
   }
   cuts_ = std::move(cuts);

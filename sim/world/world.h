@@ -152,6 +152,8 @@ class World final : public SimWorld {
   BodyParticleSettings<S> bodyParticle_;
   BodyBroadphase bodyBroadphase_ = BodyBroadphase::Brute;
   Vec3<S> gravityDt_ = Vec3<S>::Zero();
+  S sleepLinear_{}, sleepAngular_{};
+  int32_t kTicksToSleep = 30;
   std::vector<S> dispX_, dispY_, dispZ_;  ///< per-particle tip displacement (patch-state scratch)
   std::vector<S> rowScratch_;             ///< per-worker interpolation row
   int64_t rowsPerChunk_ = 1;
