@@ -31,10 +31,11 @@ std::vector<ParticleRange> particleRanges(const std::vector<RigidBody<S>>& bodie
 template <class S>
 int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid, const std::vector<RigidBody<S>>& bodies,
                                  const std::vector<ParticleRange>& ranges, const BodyParticleSettings<S>& s,
-                                 int64_t rowBegin, int64_t rowEnd) {
+                                 int64_t rowBegin, int64_t rowEnd, int64_t* pushedPerBody) {
   using T = ScalarTraits<S>;
   size_t rangeIndex = 0;
-  for (const RigidBody<S>& body : bodies) {
+  for (size_t bodyIndex = 0; bodyIndex < bodies.size(); ++bodyIndex) {
+    const RigidBody<S>& body = bodies[bodyIndex];
     const S share = s.particleInvMass / (s.particleInvMass + body.invMass);
     for (size_t part = 0; part < body.parts.size(); ++part, ++rangeIndex) {
       const ParticleRange& r = ranges[rangeIndex];
@@ -52,6 +53,7 @@ int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid
             if (dist >= shape.radius) continue;
             const Vec3<S> n = dist == S(0) ? Vec3<S>(Vec3<S>::UnitY()) : Vec3<S>(d / dist);
             const Vec3<S> moved = p + n * ((shape.radius - dist) * share);
+            if (pushedPerBody) ++pushedPerBody[bodyIndex];
             pa.px[i] = moved.x();
             pa.py[i] = moved.y();
             pa.pz[i] = moved.z();
@@ -61,6 +63,7 @@ int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid
             if (abs(local.x()) >= h.x() || abs(local.y()) >= h.y() || abs(local.z()) >= h.z()) continue;
             S gap, side;
             const int axis = nearestFaceAxis(local, h, &gap, &side);
+            if (pushedPerBody) ++pushedPerBody[bodyIndex];
             if (s.boxNormal == BoxParticleNormal::Up) {
               pa.py[i] -= gap * share;
             } else {
@@ -84,7 +87,8 @@ int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid
   template std::vector<ParticleRange> particleRanges(const std::vector<RigidBody<S>>&, const ParticleGrid&,          \
                                                      const BodyParticleSettings<S>&);                                 \
   template int64_t pushParticlesOutOfBodies(ParticleArrays<S>&, const ParticleGrid&, const std::vector<RigidBody<S>>&, \
-                                            const std::vector<ParticleRange>&, const BodyParticleSettings<S>&, int64_t, int64_t);
+                                            const std::vector<ParticleRange>&, const BodyParticleSettings<S>&, int64_t, int64_t, \
+                                            int64_t*);
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE)
 #undef SG_INSTANTIATE
 }  // namespace sg

@@ -42,10 +42,12 @@ template <class S>
 std::vector<ParticleRange> particleRanges(const std::vector<RigidBody<S>>& bodies, const ParticleGrid& grid,
                                           const BodyParticleSettings<S>& settings);
 
-/// Applies every body to particle rows [rowBegin, rowEnd). Returns the first faulting particle or -1.
+/// Applies every body to particle rows [rowBegin, rowEnd). Adds the number of particles each body
+/// pushed to pushedPerBody[body] (may be null). Returns the first faulting particle or -1.
 template <class S>
 int64_t pushParticlesOutOfBodies(ParticleArrays<S>& particles, const ParticleGrid& grid,
                                  const std::vector<RigidBody<S>>& bodies, const std::vector<ParticleRange>& ranges,
-                                 const BodyParticleSettings<S>& settings, int64_t rowBegin, int64_t rowEnd);
+                                 const BodyParticleSettings<S>& settings, int64_t rowBegin, int64_t rowEnd,
+                                 int64_t* pushedPerBody);
 
 }  // namespace sg

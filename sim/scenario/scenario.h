@@ -141,6 +141,9 @@ struct Scenario {
     BodyBroadphase bodyBroadphase = BodyBroadphase::Brute;
     BoxParticleNormal boxParticleNormal = BoxParticleNormal::Up;
     Rational mowerCutHeight{1, 5};  ///< m above the ground: where a mower's blade cuts the tufts
+    /// Grass drag on bodies, N s/m per tuft pushed this tick (0: off, the thesis model): each
+    /// pushed tuft resists the body's motion, v *= 1 - min(1, drag * tufts * dt / m).
+    Rational grassDrag{0, 1};
     std::vector<BodySpec> list;
   } bodies;
 

@@ -66,6 +66,8 @@ uint64_t scenarioFingerprint(const Scenario& s) {
                                 int64_t(b.list.size())};
     h.write(settings, sizeof settings);
     for (const Rational& g : b.gravity) hashRational(h, g);
+    hashRational(h, b.grassDrag);
+    hashRational(h, b.mowerCutHeight);
     for (const BodySpec& body : b.list) {
       h.write(body.name.data(), body.name.size());
       for (const ShapeSpec& part : body.parts) {
@@ -169,6 +171,7 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   solver_.restitutionThreshold = S(1);
   solver_.linearSlop = toS<S>(Rational{1, 2000});  // 0.5 mm
   bodyBroadphase_ = s.bodies.bodyBroadphase;
+  grassDragDt_ = toS<S>(s.bodies.grassDrag) * particleConsts_.dt;
   sleepLinear_ = toS<S>(Rational{1, 20});   // 5 cm/s
   sleepAngular_ = toS<S>(Rational{1, 20});  // 0.05 rad/s
   kTicksToSleep = std::max<int32_t>(1, int32_t(*div(Rational{1, 2}, s.timeStep)->roundToInt64()));  // 0.5 s
@@ -413,9 +416,24 @@ bool World<S>::respondToContacts() {
   mowGrass();
   // Grass: pushed out of every body (particle rows in parallel, bodies in id order).
   const std::vector<ParticleRange> ranges = particleRanges(bodies_, grid_, bodyParticle_);
-  return runParticleRows(Stage::Response, [&](int64_t row, int64_t, int64_t) {
-    return pushParticlesOutOfBodies(particles_, grid_, bodies_, ranges, bodyParticle_, row, row + 1);
+  const bool drag = grassDragDt_ > S(0);
+  // Per-row push counts (integers, summed in row order below: the same for any thread count).
+  std::vector<int64_t> pushed(drag ? size_t(grid_.countZ) * bodies_.size() : 0, 0);
+  const bool ok = runParticleRows(Stage::Response, [&](int64_t row, int64_t, int64_t) {
+    return pushParticlesOutOfBodies(particles_, grid_, bodies_, ranges, bodyParticle_, row, row + 1,
+                                    drag ? pushed.data() + size_t(row) * bodies_.size() : nullptr);
   });
+  if (!ok || !drag) return ok;
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    int64_t tufts = 0;
+    for (int64_t row = 0; row < grid_.countZ; ++row) tufts += pushed[size_t(row) * bodies_.size() + b];
+    if (tufts == 0) continue;
+    RigidBody<S>& body = bodies_[b];
+    const S loss = minS(S(1), mulInt(grassDragDt_ * body.invMass, tufts));
+    body.velocity *= S(1) - loss;
+    body.angularVelocity *= S(1) - loss;
+  }
+  return !bodiesFaulted(Stage::Response);
 }
 
 template <class S>

@@ -153,6 +153,7 @@ class World final : public SimWorld {
   BodyBroadphase bodyBroadphase_ = BodyBroadphase::Brute;
   Vec3<S> gravityDt_ = Vec3<S>::Zero();
   S sleepLinear_{}, sleepAngular_{};
+  S grassDragDt_{};  ///< grassDrag * dt (N s/m * s = kg per tuft)
   int32_t kTicksToSleep = 30;
   std::vector<S> dispX_, dispY_, dispZ_;  ///< per-particle tip displacement (patch-state scratch)
   std::vector<S> rowScratch_;             ///< per-worker interpolation row
