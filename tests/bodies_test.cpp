@@ -8,32 +8,15 @@
 namespace sg {
 namespace {
 
+using test::emptyWorld;
+using test::r3;
+using test::sphere;
+
 template <class S>
 double d(S v) { return ScalarTraits<S>::toDouble(v); }
 
-Rational3 r3(int64_t x, int64_t y, int64_t z, int64_t den = 1) {
-  return {*Rational::make(x, den), *Rational::make(y, den), *Rational::make(z, den)};
-}
 
-/// A tiny meadow far from the bodies (bodies are what these tests look at).
-Scenario emptyWorld() {
-  Scenario s = test::thesisMeadow();
-  s.field.patchesX = s.field.patchesZ = 2;
-  s.field.centerX = Rational{-500, 1};
-  s.wind.schedule.clear();
-  return s;
-}
 
-BodySpec sphere(const char* name, Rational radius, Rational3 position) {
-  BodySpec b;
-  b.name = name;
-  ShapeSpec p;
-  p.type = ShapeType::Sphere;
-  p.radius = radius;
-  b.parts = {p};
-  b.position = position;
-  return b;
-}
 
 using test::makeTyped;
 

@@ -15,6 +15,10 @@
 namespace sg {
 namespace {
 
+using test::emptyWorld;
+using test::r3;
+using test::sphere;
+
 template <class S>
 double d(S v) { return ScalarTraits<S>::toDouble(v); }
 
@@ -22,33 +26,12 @@ constexpr double kG = 9.81;
 constexpr double kDt = 1.0 / 60.0;
 constexpr double kSlop = 0.0005;  // linearSlop of the position pass (world.cpp)
 
-Rational3 r3(int64_t x, int64_t y, int64_t z, int64_t den = 1) {
-  return {*Rational::make(x, den), *Rational::make(y, den), *Rational::make(z, den)};
-}
 /// A double as an exact fraction with 1e-12 resolution (below every scalar's: Q32.32 has
 /// 2.3e-10); the scalar then rounds that fraction once.
 Rational q12(double v) { return *Rational::make(std::llround(v * 1e12), 1000000000000); }
 Rational3 q12(double x, double y, double z) { return {q12(x), q12(y), q12(z)}; }
 
-/// A tiny meadow far from the bodies (bodies are what these tests look at).
-Scenario emptyWorld() {
-  Scenario s = test::thesisMeadow();
-  s.field.patchesX = s.field.patchesZ = 2;
-  s.field.centerX = Rational{-500, 1};
-  s.wind.schedule.clear();
-  return s;
-}
 
-BodySpec sphere(const char* name, Rational radius, Rational3 position) {
-  BodySpec b;
-  b.name = name;
-  ShapeSpec p;
-  p.type = ShapeType::Sphere;
-  p.radius = radius;
-  b.parts = {p};
-  b.position = position;
-  return b;
-}
 
 /// A cube of edge 0.5 m, mass 1 kg, restitution 0.
 BodySpec cube(const std::string& name, Rational3 position, Rational friction) {

@@ -39,4 +39,30 @@ std::unique_ptr<World<S>> makeTyped(Scenario s) {
   return std::make_unique<World<S>>(s, 1);
 }
 
+/// (x, y, z) / den as exact fractions.
+inline Rational3 r3(int64_t x, int64_t y, int64_t z, int64_t den = 1) {
+  return {*Rational::make(x, den), *Rational::make(y, den), *Rational::make(z, den)};
+}
+
+/// A tiny meadow far from the bodies (bodies are what the body tests look at).
+inline Scenario emptyWorld() {
+  Scenario s = thesisMeadow();
+  s.field.patchesX = s.field.patchesZ = 2;
+  s.field.centerX = Rational{-500, 1};
+  s.wind.schedule.clear();
+  return s;
+}
+
+/// A sphere body of the given radius at a position (defaults for everything else).
+inline BodySpec sphere(const char* name, Rational radius, Rational3 position) {
+  BodySpec b;
+  b.name = name;
+  ShapeSpec p;
+  p.type = ShapeType::Sphere;
+  p.radius = radius;
+  b.parts = {p};
+  b.position = position;
+  return b;
+}
+
 }  // namespace sg::test
