@@ -10,6 +10,7 @@ namespace {
 
 using test::emptyWorld;
 using test::r3;
+using test::slope;
 using test::sphere;
 
 template <class S>
@@ -108,19 +109,6 @@ TEST(Bodies, RestingSphereStaysPutFx32) { expectRestingSphereStill<Fx32>(); }
 TEST(Bodies, RestingSphereStaysPutDouble) { expectRestingSphereStill<double>(); }
 
 // ---- slopes -------------------------------------------------------------------------------------------
-/// An exact plane rising along +x with slope 1/4: samples 15 x (x = 0..16, 1 m apart, the map
-/// centred at 0) and maxHeight 17/4 m give h = (x + 8) / 4 exactly, i.e. h(0) = 2.
-Scenario slope() {
-  Scenario s = emptyWorld();
-  s.terrain.flat = false;
-  s.terrain.cellSize = Rational{1, 1};
-  s.terrain.maxHeight = Rational{17, 4};
-  s.terrain.heightmap.width = 17;
-  s.terrain.heightmap.height = 3;
-  for (int z = 0; z < 3; ++z)
-    for (int x = 0; x < 17; ++x) s.terrain.heightmap.samples.push_back(uint8_t(15 * x));
-  return s;
-}
 
 TEST(Bodies, SphereRollingDownAnInclineReachesRollingSpeed) {
   // tan(theta) = 4/16: a rolling sphere needs mu >= 2/7 tan(theta) = 0.07; mu = 1.

@@ -17,6 +17,7 @@ namespace {
 
 using test::emptyWorld;
 using test::r3;
+using test::slope;
 using test::sphere;
 
 template <class S>
@@ -55,20 +56,6 @@ void run(World<S>& w, const Scenario& s, int64_t ticks) {
   for (int64_t t = 0; t < ticks; ++t) ASSERT_TRUE(w.step(scriptedInput(s, w.tick())).ok) << "tick " << w.tick();
 }
 
-// ---- the slope (copied from bodies_test.cpp) -----------------------------------------------------
-/// An exact plane rising along +x with slope 1/4: samples 15 x (x = 0..16, 1 m apart, the map
-/// centred at 0) and maxHeight 17/4 m give h = (x + 8) / 4 exactly, i.e. h(0) = 2.
-Scenario slope() {
-  Scenario s = emptyWorld();
-  s.terrain.flat = false;
-  s.terrain.cellSize = Rational{1, 1};
-  s.terrain.maxHeight = Rational{17, 4};
-  s.terrain.heightmap.width = 17;
-  s.terrain.heightmap.height = 3;
-  for (int z = 0; z < 3; ++z)
-    for (int x = 0; x < 17; ++x) s.terrain.heightmap.samples.push_back(uint8_t(15 * x));
-  return s;
-}
 
 const double kTheta = std::atan(0.25);  // 14.04 deg
 const double kSin = std::sin(kTheta), kCos = std::cos(kTheta);

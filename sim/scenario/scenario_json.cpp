@@ -177,6 +177,13 @@ class Reader {
     for (size_t i = 0; i < N; ++i) out[i] = number(j[i], path + "[" + std::to_string(i) + "]");
     return out;
   }
+  /// A world position [x, z] at j[key], if present.
+  void center(const json& j, const std::string& path, Rational* x, Rational* z) const {
+    if (!j.contains("center")) return;
+    const auto c = vector<2>(j["center"], path + ".center");
+    *x = c[0];
+    *z = c[1];
+  }
   std::string string(const json& j, const std::string& path) const {
     if (!j.is_string()) fail(path, std::string("a string, got ") + typeName(j));
     return j.get<std::string>();
@@ -207,11 +214,7 @@ void parseField(const Reader& r, const json& j, Scenario::Field& f) {
     f.jitter = r.nonNegative(j["jitter"], p + ".jitter");
     if (compare(f.jitter, Rational{1, 2}) > 0) r.failGot(p + ".jitter", "a fraction of the spacing from 0 to 0.5", j["jitter"]);
   }
-  if (j.contains("center")) {
-    auto c = r.vector<2>(j["center"], p + ".center");
-    f.centerX = c[0];
-    f.centerZ = c[1];
-  }
+  r.center(j, p, &f.centerX, &f.centerZ);
   if (j.contains("scaleY")) f.scaleY = r.positive(j["scaleY"], p + ".scaleY");
   if (j.contains("scaleXZ")) f.scaleXZ = r.positive(j["scaleXZ"], p + ".scaleXZ");
   if (j.contains("atlasVariants")) f.atlasVariants = int(r.integer(j["atlasVariants"], p + ".atlasVariants", 1, 16));
@@ -282,11 +285,7 @@ void parseTerrain(const Reader& r, const json& j, Scenario::Terrain& t, const Sc
   t.heightmapPath = r.string(j["file"], p + ".file");
   if (j.contains("cellSize")) t.cellSize = r.positive(j["cellSize"], p + ".cellSize");
   if (j.contains("maxHeight")) t.maxHeight = r.nonNegative(j["maxHeight"], p + ".maxHeight");
-  if (j.contains("center")) {
-    auto c = r.vector<2>(j["center"], p + ".center");
-    t.centerX = c[0];
-    t.centerZ = c[1];
-  }
+  r.center(j, p, &t.centerX, &t.centerZ);
   std::vector<uint8_t> bytes;
   std::string why;
   if (!readFile || !readFile(t.heightmapPath, &bytes, &why)) r.fail(p + ".file", why.empty() ? "a readable file" : why);
@@ -403,11 +402,7 @@ void parseMarkings(const Reader& r, const json& j, Scenario::Markings& m) {
   const std::string p = "$.markings";
   r.object(j, p, {"center", "length", "width", "lineWidth", "centerCircleRadius"});
   m.enabled = true;
-  if (j.contains("center")) {
-    auto c = r.vector<2>(j["center"], p + ".center");
-    m.centerX = c[0];
-    m.centerZ = c[1];
-  }
+  r.center(j, p, &m.centerX, &m.centerZ);
   if (j.contains("length")) m.length = r.positive(j["length"], p + ".length");
   if (j.contains("width")) m.width = r.positive(j["width"], p + ".width");
   if (j.contains("lineWidth")) m.lineWidth = r.positive(j["lineWidth"], p + ".lineWidth");

@@ -174,7 +174,7 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   grassDragDt_ = toS<S>(s.bodies.grassDrag) * particleConsts_.dt;
   sleepLinear_ = toS<S>(Rational{1, 20});   // 5 cm/s
   sleepAngular_ = toS<S>(Rational{1, 20});  // 0.05 rad/s
-  kTicksToSleep = std::max<int32_t>(1, int32_t(*div(Rational{1, 2}, s.timeStep)->roundToInt64()));  // 0.5 s
+  ticksToSleep_ = std::max<int32_t>(1, int32_t(*div(Rational{1, 2}, s.timeStep)->roundToInt64()));  // 0.5 s
   bodyParticle_.boxNormal = s.bodies.boxParticleNormal;
   bodyParticle_.broadphase = s.bodies.particleBroadphase;
   bodyParticle_.particleInvMass = toS<S>(c.invMass);
@@ -483,7 +483,7 @@ StepResult World<S>::step(const TickInput& input, StageObserver* observer) {
   });
   if (integrated && hasBodies) {
     integrateBodyPositions(bodies_, c.dt);
-    updateSleep(bodies_, sleepLinear_, sleepAngular_, kTicksToSleep);
+    updateSleep(bodies_, sleepLinear_, sleepAngular_, ticksToSleep_);
     if (bodiesFaulted(Stage::Integrate)) return {false, failure_};
   }
   end(Stage::Integrate);

@@ -154,7 +154,7 @@ class World final : public SimWorld {
   Vec3<S> gravityDt_ = Vec3<S>::Zero();
   S sleepLinear_{}, sleepAngular_{};
   S grassDragDt_{};  ///< grassDrag * dt (N s/m * s = kg per tuft)
-  int32_t kTicksToSleep = 30;
+  int32_t ticksToSleep_ = 30;
   std::vector<S> dispX_, dispY_, dispZ_;  ///< per-particle tip displacement (patch-state scratch)
   std::vector<S> rowScratch_;             ///< per-worker interpolation row
   int64_t rowsPerChunk_ = 1;
