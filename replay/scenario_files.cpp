@@ -30,16 +30,18 @@ bool readBytes(const std::filesystem::path& path, std::vector<uint8_t>* out, std
 }
 }  // namespace
 
-Scenario loadScenarioFile(const std::string& path) {
+Scenario loadScenarioFile(const std::string& path, std::vector<sgr::EmbeddedFile>* files) {
   if (path.empty()) return parseScenario(defaultScenarioText(), "<built-in thesis-meadow>", {});
   std::vector<uint8_t> bytes;
   std::string error;
   if (!readBytes(path, &bytes, &error)) throw ScenarioError(path, "$", error);
   if (bytes.size() > (size_t(64) << 20)) throw ScenarioError(path, "$", "a scenario file under 64 MiB");
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
-  auto readRelative = [dir](const std::string& name, std::vector<uint8_t>* out, std::string* why) {
+  auto readRelative = [dir, files](const std::string& name, std::vector<uint8_t>* out, std::string* why) {
     const std::filesystem::path p = std::filesystem::path(name).is_absolute() ? std::filesystem::path(name) : dir / name;
-    return readBytes(p, out, why);
+    if (!readBytes(p, out, why)) return false;
+    if (files) files->push_back(sgr::EmbeddedFile{name, *out});
+    return true;
   };
   return parseScenario(std::string(bytes.begin(), bytes.end()), path, readRelative);
 }

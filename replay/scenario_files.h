@@ -5,12 +5,14 @@
 #include <cstdint>
 #include <string>
 
+#include "replay/format/sgr_format.h"
 #include "sim/scenario/scenario.h"
 
 namespace sg {
 
-/// Reads and parses a scenario file; an empty path gives the embedded thesis meadow.
-Scenario loadScenarioFile(const std::string& path);
+/// Reads and parses a scenario file; an empty path gives the embedded thesis meadow. When
+/// `files` is given, it receives every file the scenario named (for embedding in recordings).
+Scenario loadScenarioFile(const std::string& path, std::vector<sgr::EmbeddedFile>* files = nullptr);
 
 /// Physical memory of this machine in bytes (the default memory budget for a world).
 uint64_t physicalMemoryBytes();

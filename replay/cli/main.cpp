@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <string>
 
+#include "replay/cli/record_command.h"
+#include "replay/cli/replay_command.h"
 #include "replay/cli/run_command.h"
 
 int main(int argc, char** argv) {
@@ -11,6 +13,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("simgrass ") + SIMGRASS_VERSION);
   int exitCode = 0;
   sg::addRunCommand(app, &exitCode);
+  sg::addRecordCommand(app, &exitCode);
+  sg::addReplayCommand(app, &exitCode);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

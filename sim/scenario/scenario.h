@@ -180,6 +180,21 @@ using ScenarioFileReader =
 Scenario parseScenario(const std::string& text, const std::string& sourceName,
                        const ScenarioFileReader& readFile);
 
+/// An input-track file (docs/scenario-format.md): camera keys and body commands that replace a
+/// scenario's script when recording. Commands name bodies of `scenario` and use the script's
+/// schema; the camera holds each key's position until the next key.
+struct CameraKey {
+  int64_t tick = 0;
+  Rational3 position{Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
+};
+struct InputTrack {
+  std::optional<int64_t> ticks;        ///< how long to record, when the track says
+  std::vector<CameraKey> camera;       ///< increasing ticks
+  std::vector<ScriptedCommand> commands;  ///< sorted by tick
+};
+/// Throws ScenarioError (file, JSON path, expected) like parseScenario.
+InputTrack parseInputTrack(const std::string& text, const std::string& sourceName, const Scenario& scenario);
+
 /// The thesis meadow, embedded (identical to scenarios/thesis-meadow.json).
 const std::string& defaultScenarioText();
 

@@ -409,8 +409,8 @@ void parseMarkings(const Reader& r, const json& j, Scenario::Markings& m) {
   if (j.contains("centerCircleRadius")) m.centerCircleRadius = r.nonNegative(j["centerCircleRadius"], p + ".centerCircleRadius");
 }
 
-void parseScript(const Reader& r, const json& j, Scenario& s) {
-  const std::string p = "$.script";
+void parseScript(const Reader& r, const json& j, const Scenario& s, const std::string& p,
+                 std::vector<ScriptedCommand>& script) {
   if (!j.is_array() || j.size() > 1000000) r.failGot(p, "an array of commands", j);
   for (size_t i = 0; i < j.size(); ++i) {
     const std::string q = p + "[" + std::to_string(i) + "]";
@@ -431,9 +431,9 @@ void parseScript(const Reader& r, const json& j, Scenario& s) {
                                           {"impulse", BodyCommandKind::Impulse}, {"teleport", BodyCommandKind::Teleport}});
     if (!c.contains("value")) r.fail(q + ".value", "a vector [x, y, z] (missing)");
     cmd.value = r.vector<3>(c["value"], q + ".value");
-    s.script.push_back(cmd);
+    script.push_back(cmd);
   }
-  std::stable_sort(s.script.begin(), s.script.end(), [](const ScriptedCommand& a, const ScriptedCommand& b) {
+  std::stable_sort(script.begin(), script.end(), [](const ScriptedCommand& a, const ScriptedCommand& b) {
     return a.tick < b.tick;
   });
 }
@@ -475,7 +475,10 @@ std::string oneLine(const std::string& s) {
 ScenarioError::ScenarioError(const std::string& file, const std::string& path, const std::string& expected)
     : std::runtime_error(oneLine(file + ": " + path + ": expected " + expected)), file_(file), path_(path) {}
 
-Scenario parseScenario(const std::string& text, const std::string& sourceName, const ScenarioFileReader& readFile) {
+namespace {
+/// Parses JSON text, reporting the byte and line of a syntax error and the path of a number that
+/// overflows; `raw` receives every number as written (for exact rationals).
+json loadJson(const std::string& text, const std::string& sourceName, std::map<std::string, std::string>* raw) {
   // The SAX pass first: it knows the JSON path of a number that overflows a double.
   RawNumberCollector collector;
   const bool wellFormed = json::sax_parse(text, &collector);
@@ -497,7 +500,15 @@ Scenario parseScenario(const std::string& text, const std::string& sourceName, c
   if (!collector.duplicatePath.empty())
     throw ScenarioError(sourceName, collector.duplicatePath, "each key once (this key appears twice)");
 
-  Reader r(sourceName, collector.raw);
+  *raw = std::move(collector.raw);
+  return root;
+}
+}  // namespace
+
+Scenario parseScenario(const std::string& text, const std::string& sourceName, const ScenarioFileReader& readFile) {
+  std::map<std::string, std::string> raw;
+  const json root = loadJson(text, sourceName, &raw);
+  Reader r(sourceName, raw);
   Scenario s;
   s.sourceName = sourceName;
   s.text = text;
@@ -526,7 +537,7 @@ Scenario parseScenario(const std::string& text, const std::string& sourceName, c
   if (root.contains("wind")) parseWind(r, root["wind"], s.wind);
   if (root.contains("terrain")) parseTerrain(r, root["terrain"], s.terrain, readFile);
   if (root.contains("bodies")) parseBodies(r, root["bodies"], s.bodies);
-  if (root.contains("script")) parseScript(r, root["script"], s);
+  if (root.contains("script")) parseScript(r, root["script"], s, "$.script", s.script);
   if (root.contains("markings")) parseMarkings(r, root["markings"], s.markings);
   if (s.wind.schedule.empty()) {
     // An empty schedule is allowed: no wind.
@@ -571,6 +582,39 @@ const std::string& defaultScenarioText() {
 }
 )JSON";
   return text;
+}
+
+}  // namespace sg
+
+namespace sg {
+
+InputTrack parseInputTrack(const std::string& text, const std::string& sourceName, const Scenario& scenario) {
+  std::map<std::string, std::string> raw;
+  const json root = loadJson(text, sourceName, &raw);
+  Reader r(sourceName, raw);
+  InputTrack track;
+  r.object(root, "$", {"format", "ticks", "camera", "commands"});
+  if (!root.contains("format") || root["format"] != "simgrass-input-track/1")
+    r.failGot("$.format", "\"simgrass-input-track/1\"", root.contains("format") ? root["format"] : json());
+  if (root.contains("ticks")) track.ticks = r.integer(root["ticks"], "$.ticks", 0, int64_t(1) << 40);
+  if (root.contains("camera")) {
+    const json& cams = root["camera"];
+    if (!cams.is_array() || cams.size() > 10000000) r.failGot("$.camera", "an array of {tick, position}", cams);
+    for (size_t i = 0; i < cams.size(); ++i) {
+      const std::string q = "$.camera[" + std::to_string(i) + "]";
+      r.object(cams[i], q, {"tick", "position"});
+      if (!cams[i].contains("tick")) r.fail(q + ".tick", "the tick the camera moves (missing)");
+      if (!cams[i].contains("position")) r.fail(q + ".position", "a position [x, y, z] (missing)");
+      CameraKey key;
+      key.tick = r.integer(cams[i]["tick"], q + ".tick", 0, int64_t(1) << 40);
+      if (!track.camera.empty() && key.tick <= track.camera.back().tick)
+        r.failGot(q + ".tick", "a tick after the previous camera key's " + std::to_string(track.camera.back().tick), cams[i]["tick"]);
+      key.position = r.vector<3>(cams[i]["position"], q + ".position");
+      track.camera.push_back(key);
+    }
+  }
+  if (root.contains("commands")) parseScript(r, root["commands"], scenario, "$.commands", track.commands);
+  return track;
 }
 
 }  // namespace sg

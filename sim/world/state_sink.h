@@ -6,6 +6,12 @@
 #include <vector>
 
 #include <xxhash.h>
+#if defined(__x86_64__) || defined(__i386__)
+#include <xxh_x86dispatch.h>  // the package's runtime AVX2/AVX-512 selection (same digests)
+#define SG_XXH3_UPDATE XXH3_64bits_update_dispatch
+#else
+#define SG_XXH3_UPDATE XXH3_64bits_update
+#endif
 
 namespace sg {
 
@@ -24,14 +30,18 @@ class ByteSink final : public StateSink {
   }
 };
 
-/// xxHash3-64 over everything written, streamed (no copy of the state).
+/// xxHash3-64 over everything written, streamed (no copy of the state). On x86 it calls the
+/// library's dispatching entry point, which picks the widest vector unit at run time: the digest
+/// is defined by the XXH3 spec and identical on every path, but AVX2 hashes the thesis meadow's
+/// 1.1 MB state in ~25 us instead of ~57 us (the SSE2 default), i.e. ~2.5% of a tick instead of
+/// ~6% when recording a CHECK every tick.
 class HashSink final : public StateSink {
  public:
   HashSink() : state_(XXH3_createState()) { XXH3_64bits_reset(state_); }
   ~HashSink() override { XXH3_freeState(state_); }
   HashSink(const HashSink&) = delete;
   HashSink& operator=(const HashSink&) = delete;
-  void write(const void* data, size_t n) override { XXH3_64bits_update(state_, data, n); }
+  void write(const void* data, size_t n) override { SG_XXH3_UPDATE(state_, data, n); }
   uint64_t digest() const { return XXH3_64bits_digest(state_); }
  private:
   XXH3_state_t* state_;

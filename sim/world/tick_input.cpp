@@ -13,14 +13,33 @@ int64_t toInputRaw(const Rational& value) {
   return int64_t(*raw);
 }
 
+namespace {
+InputVec3 toInputVec3(const Rational3& v) { return InputVec3{toInputRaw(v[0]), toInputRaw(v[1]), toInputRaw(v[2])}; }
+
+void addCommands(const std::vector<ScriptedCommand>& script, int64_t tick, TickInput& input) {
+  // The script is sorted by tick: binary search for this tick's commands.
+  auto first = std::lower_bound(script.begin(), script.end(), tick,
+                                [](const ScriptedCommand& c, int64_t t) { return c.tick < t; });
+  for (auto it = first; it != script.end() && it->tick == tick; ++it)
+    input.bodies.push_back(BodyCommand{it->body, it->kind, toInputVec3(it->value)});
+}
+}  // namespace
+
 TickInput scriptedInput(const Scenario& scenario, int64_t tick) {
   TickInput input;
-  // The script is sorted by tick: binary search for this tick's commands.
-  auto first = std::lower_bound(scenario.script.begin(), scenario.script.end(), tick,
-                                [](const ScriptedCommand& c, int64_t t) { return c.tick < t; });
-  for (auto it = first; it != scenario.script.end() && it->tick == tick; ++it)
-    input.bodies.push_back(BodyCommand{it->body, it->kind,
-                                       InputVec3{toInputRaw(it->value[0]), toInputRaw(it->value[1]), toInputRaw(it->value[2])}});
+  addCommands(scenario.script, tick, input);
+  return input;
+}
+
+TickInput trackInput(const InputTrack& track, int64_t tick) {
+  TickInput input;
+  auto key = std::upper_bound(track.camera.begin(), track.camera.end(), tick,
+                              [](int64_t t, const CameraKey& k) { return t < k.tick; });
+  if (key != track.camera.begin()) {
+    input.hasCamera = true;
+    input.camera = toInputVec3((key - 1)->position);
+  }
+  addCommands(track.commands, tick, input);
   return input;
 }
 

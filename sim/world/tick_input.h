@@ -35,6 +35,9 @@ struct TickInput {
 /// The scenario's scripted commands for one tick (empty when it has none).
 TickInput scriptedInput(const Scenario& scenario, int64_t tick);
 
+/// An input track's input for one tick: the latest camera key at or before it, that tick's commands.
+TickInput trackInput(const InputTrack& track, int64_t tick);
+
 /// Q32.32 raw of an exact value (saturating; scenario validation keeps values in range).
 int64_t toInputRaw(const Rational& value);
 

@@ -677,6 +677,30 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   updatePatchState();
 }
 
+template <class S>
+void World<S>::observe(Observation& out) const {
+  out.tick = tick_;
+  out.patchesX = lattice_.patchesX;
+  out.patchesZ = lattice_.patchesZ;
+  const size_t n = size_t(lattice_.patchesX * lattice_.patchesZ);
+  out.tipX.resize(n);
+  out.tipY.resize(n);
+  out.tipZ.resize(n);
+  for (size_t p = 0; p < n; ++p) {
+    out.tipX[p] = ScalarTraits<S>::toDouble(patches_.rootX[p] + patches_.tipOffsetX[p]);
+    out.tipY[p] = ScalarTraits<S>::toDouble(patches_.topY[p]);
+    out.tipZ[p] = ScalarTraits<S>::toDouble(patches_.rootZ[p] + patches_.tipOffsetZ[p]);
+  }
+  out.bodyPosition.clear();
+  out.bodyOrientation.clear();
+  for (const RigidBody<S>& b : bodies_) {
+    for (int a = 0; a < 3; ++a) out.bodyPosition.push_back(ScalarTraits<S>::toDouble(b.position[a]));
+    for (const S q : {b.orientation.w(), b.orientation.x(), b.orientation.y(), b.orientation.z()})
+      out.bodyOrientation.push_back(ScalarTraits<S>::toDouble(q));
+  }
+  out.contacts = int64_t(contacts_.size());
+}
+
 std::unique_ptr<SimWorld> makeWorld(const Scenario& scenario, int threads, uint64_t memoryLimitBytes) {
   validateForScalar(scenario, scenario.scalar, memoryLimitBytes);
   return dispatchScalar(scenario.scalar, [&]<class S>() -> std::unique_ptr<SimWorld> {

@@ -68,6 +68,16 @@ struct WorldCounts {
   int64_t particles() const { return particlesX * particlesZ; }
 };
 
+/// What diff and compare measure, converted to double: every tuft's tip and every body's pose.
+struct Observation {
+  int64_t tick = 0;
+  int64_t patchesX = 0, patchesZ = 0;
+  std::vector<double> tipX, tipY, tipZ;  ///< per patch (row-major, i fastest): top-vertex centre, m
+  std::vector<double> bodyPosition;      ///< 3 per body, m
+  std::vector<double> bodyOrientation;   ///< 4 per body (w, x, y, z)
+  int64_t contacts = 0;                  ///< body contacts found in the last tick
+};
+
 /// Scalar-erased interface used by tools (command line, replay, viewer).
 class SimWorld {
  public:
@@ -83,6 +93,8 @@ class SimWorld {
   /// Throws StateError when the bytes are not a state of this world's scenario and scalar.
   virtual void restoreState(std::span<const uint8_t> bytes) = 0;
   virtual void setThreads(int threads) = 0;
+  /// Fills `out` (reusing its storage) with the current tips and body poses.
+  virtual void observe(Observation& out) const = 0;
 };
 
 /// Builds a world for scenario.scalar. Throws ScenarioError when the scenario does not fit it.
@@ -101,6 +113,7 @@ class World final : public SimWorld {
   std::vector<uint8_t> saveState() const override;
   void restoreState(std::span<const uint8_t> bytes) override;
   void setThreads(int threads) override;
+  void observe(Observation& out) const override;
 
   // Read access for tests, tools and the renderer.
   const ParticleArrays<S>& particles() const { return particles_; }

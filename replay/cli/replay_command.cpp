@@ -1,0 +1,175 @@
+#include "replay/cli/replay_command.h"
+
+#include <chrono>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "replay/cli/cli_common.h"
+#include "replay/player.h"
+#include "replay/progress.h"
+
+namespace sg {
+namespace {
+struct ReplayOptions {
+  std::string file, exportState;
+  bool verify = false, info = false, json = false;
+  int64_t to = -1;
+  int threads = 1;
+};
+
+/// The hash the recording holds for `tick`, if any.
+std::optional<uint64_t> recordedHash(const sgr::Recording& r, int64_t tick) {
+  if (tick == r.header.startTick) return r.header.initialStateHash;
+  for (const sgr::Check& c : r.checks)
+    if (c.tick == tick) return c.hash;
+  for (const sgr::SnapshotInfo& s : r.snapshots)
+    if (s.tick == tick) return s.hash;
+  if (r.end && !r.end->faulted && r.end->tick == tick) return r.end->hash;
+  return std::nullopt;
+}
+
+nlohmann::json headerJson(const sgr::Recording& r) {
+  return {{"file", r.file},
+          {"scenario", r.header.scenarioSource},
+          {"variant", r.header.variant},
+          {"build", r.header.buildId},
+          {"checkEvery", r.header.checkEvery},
+          {"snapshotEvery", r.header.snapshotEvery},
+          {"lastTick", r.lastTick()},
+          {"complete", r.end.has_value()},
+          {"inputs", r.inputs.size()},
+          {"checks", r.checks.size()},
+          {"snapshots", r.snapshots.size()}};
+}
+
+int replay(const ReplayOptions& o) {
+  std::unique_ptr<sgr::Recording> rec;
+  try {
+    rec = std::make_unique<sgr::Recording>(sgr::readRecording(o.file));
+  } catch (const sgr::RecordingError& e) {
+    std::fprintf(stderr, "simgrass replay: %s\n", e.what());
+    return kExitBadInput;
+  }
+  if (rec->truncated)
+    std::fprintf(stderr, "simgrass replay: warning: %s: byte %" PRIu64 ": expected %s; replaying the %" PRId64
+                         " ticks before it\n",
+                 o.file.c_str(), rec->truncatedAt, rec->truncatedExpected.c_str(), rec->lastTick());
+  nlohmann::json out = headerJson(*rec);
+  if (o.info) {
+    if (o.json) {
+      std::printf("%s\n", out.dump(2).c_str());
+    } else {
+      std::printf("recording  %s (%s)\n", o.file.c_str(), rec->end ? "complete" : "cut off before END");
+      std::printf("scenario   %s, %s\n", rec->header.scenarioSource.c_str(), rec->header.variant.c_str());
+      std::printf("built by   %s\n", rec->header.buildId.c_str());
+      std::printf("ticks      %" PRId64 " to %" PRId64 "; %zu input chunks, %zu hashes, %zu snapshots\n",
+                  rec->header.startTick, rec->lastTick(), rec->inputs.size(), rec->checks.size(), rec->snapshots.size());
+    }
+    return rec->truncated ? kExitTruncated : kExitOk;
+  }
+  std::unique_ptr<Player> player;
+  try {
+    player = std::make_unique<Player>(*rec, o.threads);
+  } catch (const sgr::RecordingError& e) {
+    std::fprintf(stderr, "simgrass replay: %s\n", e.what());
+    return kExitBadInput;
+  }
+  const int64_t last = rec->lastTick();
+  if (o.to > last) {
+    std::fprintf(stderr, "simgrass replay: --to: expected a tick from %" PRId64 " to %" PRId64 " (the recording's last), got %" PRId64 "\n",
+                 rec->header.startTick, last, o.to);
+    return kExitBadInput;
+  }
+  int code = kExitOk;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    if (o.verify) {
+      ProgressBar bar("verify", last - rec->header.startTick, !o.json);
+      const VerifyReport v = player->verify([&bar](int64_t done) { bar.update(done); });
+      bar.finish();
+      out["verified"] = v.ok;
+      out["ticks"] = v.ticks;
+      out["hashesChecked"] = v.checksVerified;
+      if (!v.ok) {
+        out["firstMismatchTick"] = v.firstMismatchTick;
+        if (v.fault) {
+          out["error"] = v.fault->message();
+          std::fprintf(stderr, "simgrass replay: %s: the replay faulted where the recording did not: %s\n",
+                       o.file.c_str(), v.fault->message().c_str());
+        } else {
+          out["expectedHash"] = hex(v.expectedHash);
+          out["actualHash"] = hex(v.actualHash);
+          std::fprintf(stderr, "simgrass replay: %s: hash mismatch at tick %" PRId64 ": recorded %s, replayed %s\n",
+                       o.file.c_str(), v.firstMismatchTick, hex(v.expectedHash).c_str(), hex(v.actualHash).c_str());
+        }
+        code = kExitMismatch;
+      } else if (!o.json) {
+        std::printf("verified %" PRId64 " ticks (%" PRId64 " hashes match)\n", v.ticks, v.checksVerified);
+      }
+    }
+    if (code == kExitOk && (o.to >= 0 || !o.verify)) {
+      const int64_t target = o.to >= 0 ? o.to : last;
+      ProgressBar bar("seek", target, !o.json);
+      const StepResult r = player->seek(target, [&bar](int64_t done) { bar.update(done); });
+      bar.finish();
+      if (!r.ok) {
+        std::fprintf(stderr, "simgrass replay: %s\n", r.error.message().c_str());
+        out["error"] = r.error.message();
+        code = kExitMismatch;
+      }
+    }
+  } catch (const sgr::RecordingError& e) {
+    std::fprintf(stderr, "simgrass replay: %s\n", e.what());
+    return kExitBadInput;
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const int64_t tick = player->tick();
+  const uint64_t hash = player->world().stateHash();
+  const std::optional<uint64_t> expected = recordedHash(*rec, tick);
+  out["tick"] = tick;
+  out["hash"] = hex(hash);
+  out["seconds"] = seconds;
+  if (expected) out["matchesRecording"] = *expected == hash;
+  if (code == kExitOk && expected && *expected != hash) {
+    std::fprintf(stderr, "simgrass replay: %s: hash at tick %" PRId64 " is %s, the recording has %s\n", o.file.c_str(),
+                 tick, hex(hash).c_str(), hex(*expected).c_str());
+    code = kExitMismatch;
+  }
+  if (!o.exportState.empty()) {
+    const std::vector<uint8_t> state = player->world().saveState();
+    std::ofstream f(o.exportState, std::ios::binary);
+    f.write(reinterpret_cast<const char*>(state.data()), std::streamsize(state.size()));
+    if (!f) {
+      std::fprintf(stderr, "simgrass replay: %s: cannot write the state\n", o.exportState.c_str());
+      return kExitBadInput;
+    }
+    out["exportedState"] = o.exportState;
+  }
+  if (o.json) {
+    std::printf("%s\n", out.dump(2).c_str());
+  } else {
+    std::printf("tick %" PRId64 " hash %s%s\n", tick, hex(hash).c_str(),
+                expected ? (*expected == hash ? " (matches the recording)" : " (DIFFERS from the recording)") : "");
+    if (!o.exportState.empty()) std::printf("state written to %s\n", o.exportState.c_str());
+  }
+  if (code == kExitOk && rec->truncated) code = kExitTruncated;
+  return code;
+}
+}  // namespace
+
+void addReplayCommand(CLI::App& app, int* exitCode) {
+  auto o = std::make_shared<ReplayOptions>();
+  CLI::App* cmd = app.add_subcommand("replay", "Play a .sgr recording back: verify its hashes, seek, export a state");
+  cmd->add_option("recording", o->file, "Recording (.sgr)")->required();
+  cmd->add_flag("--verify", o->verify, "Recompute every recorded hash; report the first tick that differs (exit 1)");
+  cmd->add_option("--to", o->to, "Seek to this tick through the nearest snapshot")->check(CLI::Range(int64_t(0), int64_t(1) << 40));
+  cmd->add_option("--export-state", o->exportState, "Write the state reached (SGSTATE1 bytes) to this file");
+  cmd->add_option("--threads", o->threads, "Worker threads (the result is identical for any count)")->check(CLI::Range(1, 256));
+  cmd->add_flag("--info", o->info, "Print what the recording holds without simulating");
+  cmd->add_flag("--json", o->json, "Machine-readable output");
+  cmd->footer("Exit codes: 0 ok, 1 hash mismatch or simulation fault, 2 bad input, 3 recording cut off before END "
+              "(everything up to the cut checked out).");
+  cmd->callback([o, exitCode] { *exitCode = replay(*o); });
+}
+}  // namespace sg

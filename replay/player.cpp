@@ -1,0 +1,151 @@
+#include "replay/player.h"
+
+#include <algorithm>
+
+#include "replay/scenario_files.h"
+
+namespace sg {
+
+Scenario recordedScenario(const sgr::Recording& rec, const VariantSettings& override) {
+  const sgr::Header& h = rec.header;
+  // Files the scenario names come from the recording, never from the disk: a recording is
+  // self-contained and replays the same wherever it is moved.
+  auto embedded = [&h](const std::string& name, std::vector<uint8_t>* out, std::string* why) {
+    for (const sgr::EmbeddedFile& f : h.files)
+      if (f.name == name) {
+        *out = f.bytes;
+        return true;
+      }
+    *why = "'" + name + "' embedded in the recording (it is not)";
+    return false;
+  };
+  Scenario s;
+  const std::string where = rec.file + " (scenario '" + h.scenarioSource + "' in HEAD)";
+  try {
+    s = parseScenario(h.scenarioText, where, embedded);
+  } catch (const ScenarioError& e) {
+    throw sgr::RecordingError(rec.file, sgr::kPreambleBytes, std::string("a scenario that loads: ") + e.what());
+  }
+  VariantSettings recorded;
+  try {
+    recorded = VariantSettings::parse(h.variant);
+  } catch (const std::invalid_argument& e) {
+    throw sgr::RecordingError(rec.file, sgr::kPreambleBytes, std::string("valid variant settings: ") + e.what());
+  }
+  if (recorded.scalar && *recorded.scalar != h.scalar)
+    throw sgr::RecordingError(rec.file, sgr::kPreambleBytes + sgr::kChunkHeaderBytes,
+                              "the header's scalar type to match its variant settings");
+  override.over(recorded).applyTo(s);
+  return s;
+}
+
+Player::Player(const sgr::Recording& recording, int threads, const VariantSettings& variant)
+    : recording_(recording), threads_(variant.threads.value_or(threads)) {
+  scenario_ = recordedScenario(recording, variant);
+  const VariantSettings recorded = VariantSettings::parse(recording.header.variant);
+  sameSettings_ = variant.mustBeIdenticalTo(recorded);
+  try {
+    world_ = makeWorld(scenario_, threads_);
+  } catch (const ScenarioError& e) {
+    throw sgr::RecordingError(recording.file, sgr::kPreambleBytes, std::string("a scenario this build can run: ") + e.what());
+  }
+  const int64_t bodies = world_->counts().bodies;
+  for (const sgr::InputRecord& in : recording.inputs)
+    for (const BodyCommand& c : in.input.bodies)
+      if (c.body >= bodies)
+        throw sgr::RecordingError(recording.file, in.offset,
+                                  "commands for the scenario's " + std::to_string(bodies) + " bodies, got body " +
+                                      std::to_string(c.body) + " at tick " + std::to_string(in.tick));
+  if (sameSettings_ && world_->stateHash() != recording.header.initialStateHash && recording.header.startTick == 0)
+    throw sgr::RecordingError(recording.file, sgr::kPreambleBytes,
+                              "an initial state this build reproduces (the scenario builds a different world: "
+                              "the physics or the scenario format changed since it was recorded)");
+}
+
+void Player::restart() {
+  world_ = makeWorld(scenario_, threads_);
+}
+
+StepResult Player::stepForward(StageObserver* observer) {
+  return world_->step(recording_.inputAt(world_->tick()), observer);
+}
+
+StepResult Player::seek(int64_t target, const std::function<void(int64_t)>& progress) {
+  if (target < 0) target = 0;
+  // Nearest snapshot at or before the target (only when the settings match the recording's:
+  // a snapshot is a state of the recorded world).
+  const sgr::SnapshotInfo* snap = sameSettings_ ? recording_.snapshotAtOrBefore(target) : nullptr;
+  const int64_t from = world_->tick();
+  const bool forwardIsShorter = from <= target && (!snap || snap->tick <= from);
+  if (!forwardIsShorter) {
+    if (snap) {
+      const std::vector<uint8_t> state = recording_.snapshotState(*snap);
+      try {
+        world_->restoreState(state);
+      } catch (const StateError& e) {
+        throw sgr::RecordingError(recording_.file, snap->offset,
+                                  "a snapshot of this scenario's state (state byte " + std::to_string(e.offset()) +
+                                      ": expected " + e.what() + ")");
+      }
+      if (world_->stateHash() != snap->hash)
+        throw sgr::RecordingError(recording_.file, snap->offset, "a snapshot whose state matches its hash");
+    } else {
+      restart();
+    }
+  }
+  const int64_t start = world_->tick();
+  while (world_->tick() < target) {
+    StepResult r = stepForward();
+    if (!r.ok) return r;
+    if (progress) progress(world_->tick() - start);
+  }
+  return {};
+}
+
+VerifyReport Player::verify(const std::function<void(int64_t)>& progress) {
+  VerifyReport report;
+  if (world_->tick() != recording_.header.startTick) restart();
+  const bool recordedFault = recording_.end && recording_.end->faulted;
+  // A recording that stopped on a fault: replay the faulting step too, it must fault the same way.
+  const int64_t last = recordedFault ? recording_.end->tick + 1 : recording_.lastTick();
+  // Expected hashes by tick: CHCK, SNAP and END (merged, each checked once per tick).
+  std::vector<sgr::Check> expected = recording_.checks;
+  for (const sgr::SnapshotInfo& s : recording_.snapshots) expected.push_back({s.tick, s.hash});
+  if (recording_.end && !recording_.end->faulted) expected.push_back({recording_.end->tick, recording_.end->hash});
+  std::stable_sort(expected.begin(), expected.end(), [](const sgr::Check& a, const sgr::Check& b) { return a.tick < b.tick; });
+  size_t next = 0;
+  while (world_->tick() < last) {
+    StepResult r = stepForward();
+    if (!r.ok) {
+      if (!(recordedFault && recording_.end->tick == world_->tick())) {
+        report.ok = false;
+        report.fault = r.error;
+        report.firstMismatchTick = world_->tick() + 1;
+      }
+      break;
+    }
+    ++report.ticks;
+    while (next < expected.size() && expected[next].tick < world_->tick()) ++next;
+    bool hashed = false;
+    uint64_t hash = 0;
+    for (; next < expected.size() && expected[next].tick == world_->tick(); ++next) {
+      if (!hashed) hash = world_->stateHash(), hashed = true;
+      if (hash != expected[next].hash) {
+        report.ok = false;
+        report.firstMismatchTick = world_->tick();
+        report.expectedHash = expected[next].hash;
+        report.actualHash = hash;
+        return report;
+      }
+      ++report.checksVerified;
+    }
+    if (progress) progress(report.ticks);
+  }
+  if (recordedFault && report.ok && world_->tick() > recording_.end->tick) {
+    report.ok = false;  // the recording faulted at end->tick, the replay stepped past it
+    report.firstMismatchTick = recording_.end->tick + 1;
+  }
+  return report;
+}
+
+}  // namespace sg

@@ -1,0 +1,60 @@
+// Playing a recording back: rebuilds the world from the embedded scenario (optionally under a
+// variant), then steps it with the recorded inputs, seeks through snapshots and verifies hashes.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "replay/format/sgr_reader.h"
+#include "replay/variant.h"
+#include "sim/world/world.h"
+
+namespace sg {
+
+/// The scenario stored in a recording, parsed with its embedded files and the recorded variant
+/// (then `override` on top). Throws sgr::RecordingError (offset of HEAD) when it no longer loads.
+Scenario recordedScenario(const sgr::Recording& recording, const VariantSettings& override = {});
+
+struct VerifyReport {
+  bool ok = true;
+  int64_t ticks = 0;            ///< ticks replayed
+  int64_t checksVerified = 0;   ///< CHCK/SNAP/END hashes that matched
+  int64_t firstMismatchTick = -1;
+  uint64_t expectedHash = 0, actualHash = 0;
+  std::optional<SimError> fault;  ///< the replay faulted where the recording did not (or vice versa)
+};
+
+class Player {
+ public:
+  /// Builds the world. With a non-empty `variant`, the recorded inputs drive a different setup
+  /// (then CHCK hashes are not expected to match unless the variant must be bit-identical).
+  explicit Player(const sgr::Recording& recording, int threads = 1, const VariantSettings& variant = {});
+
+  const sgr::Recording& recording() const { return recording_; }
+  const Scenario& scenario() const { return scenario_; }
+  SimWorld& world() { return *world_; }
+  int64_t tick() const { return world_->tick(); }
+  /// True when the world runs with the recorded settings (hashes are comparable).
+  bool sameSettingsAsRecorded() const { return sameSettings_; }
+
+  /// Steps once with the recorded input for the current tick.
+  StepResult stepForward(StageObserver* observer = nullptr);
+  /// Moves to `tick` (0 ≤ tick ≤ recording().lastTick()): restores the latest snapshot at or
+  /// before it (or restarts from the start) unless stepping on from the current tick is shorter.
+  /// Returns the fault when a step fails. Throws sgr::RecordingError for a damaged snapshot.
+  StepResult seek(int64_t tick, const std::function<void(int64_t)>& progress = {});
+  /// Replays from the start to the end, comparing every CHCK, SNAP and END hash.
+  VerifyReport verify(const std::function<void(int64_t)>& progress = {});
+
+ private:
+  void restart();
+  const sgr::Recording& recording_;
+  Scenario scenario_;
+  int threads_;
+  bool sameSettings_ = true;
+  std::unique_ptr<SimWorld> world_;
+};
+
+}  // namespace sg

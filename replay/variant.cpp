@@ -1,0 +1,113 @@
+#include "replay/variant.h"
+
+#include <sstream>
+#include <stdexcept>
+
+namespace sg {
+namespace {
+[[noreturn]] void bad(const std::string& setting, const std::string& expected) {
+  throw std::invalid_argument(setting + ": expected " + expected);
+}
+const char* broadphaseName(ParticleBroadphase b) { return b == ParticleBroadphase::Brute ? "brute" : "grid"; }
+const char* bodyBroadphaseName(BodyBroadphase b) { return b == BodyBroadphase::SweepAndPrune ? "sap" : "brute"; }
+}  // namespace
+
+VariantSettings VariantSettings::parse(const std::string& text) {
+  VariantSettings v;
+  std::string spaced = text;
+  for (char& ch : spaced)
+    if (ch == ',') ch = ' ';
+  std::istringstream in(spaced);
+  std::string item;
+  while (in >> item) {
+    const size_t eq = item.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
+      bad(item, "key=value with a key scalar, interp, broadphase, body-broadphase, dt or threads");
+    const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
+    if (key == "scalar") {
+      const auto kind = parseScalarKind(value);
+      if (!kind) bad(item, "scalar=fx32, fx16, float or double");
+      v.scalar = *kind;
+    } else if (key == "interp") {
+      if (value.size() != 1 || value[0] < '1' || value[0] > '4') bad(item, "interp=1, 2, 3 or 4");
+      v.interpolation = value[0] - '0';
+    } else if (key == "broadphase") {
+      if (value == "grid") v.broadphase = ParticleBroadphase::Grid;
+      else if (value == "brute") v.broadphase = ParticleBroadphase::Brute;
+      else bad(item, "broadphase=grid or brute");
+    } else if (key == "body-broadphase") {
+      if (value == "brute") v.bodyBroadphase = BodyBroadphase::Brute;
+      else if (value == "sap") v.bodyBroadphase = BodyBroadphase::SweepAndPrune;
+      else bad(item, "body-broadphase=brute or sap");
+    } else if (key == "dt") {
+      std::string why;
+      const auto dt = Rational::parse(value, &why);
+      if (!dt || dt->isNegative() || dt->isZero() || compare(*dt, Rational{1, 1}) > 0 ||
+          compare(*dt, Rational{1, 100000}) < 0)
+        bad(item, "dt=a time step from 1e-5 to 1 s, e.g. dt=1/120");
+      v.timeStep = *dt;
+    } else if (key == "threads") {
+      int n = 0;
+      for (char ch : value) {
+        if (ch < '0' || ch > '9' || n > 256) bad(item, "threads=1..256");
+        n = n * 10 + (ch - '0');
+      }
+      if (n < 1 || n > 256) bad(item, "threads=1..256");
+      v.threads = n;
+    } else if (key == "lod") {
+      bad(item, "a setting this build has (the level-of-detail window is not implemented yet)");
+    } else {
+      bad(item, "a key scalar, interp, broadphase, body-broadphase, dt or threads");
+    }
+  }
+  return v;
+}
+
+VariantSettings VariantSettings::over(const VariantSettings& base) const {
+  VariantSettings v = base;
+  if (scalar) v.scalar = scalar;
+  if (interpolation) v.interpolation = interpolation;
+  if (broadphase) v.broadphase = broadphase;
+  if (bodyBroadphase) v.bodyBroadphase = bodyBroadphase;
+  if (timeStep) v.timeStep = timeStep;
+  if (threads) v.threads = threads;
+  return v;
+}
+
+void VariantSettings::applyTo(Scenario& s) const {
+  if (scalar) s.scalar = *scalar;
+  if (interpolation) s.particles.interpolation = *interpolation;
+  if (broadphase) s.bodies.particleBroadphase = *broadphase;
+  if (bodyBroadphase) s.bodies.bodyBroadphase = *bodyBroadphase;
+  if (timeStep) s.timeStep = *timeStep;
+}
+
+VariantSettings VariantSettings::resolvedFrom(const Scenario& s) {
+  VariantSettings v;
+  v.scalar = s.scalar;
+  v.interpolation = s.particles.interpolation;
+  v.broadphase = s.bodies.particleBroadphase;
+  v.bodyBroadphase = s.bodies.bodyBroadphase;
+  v.timeStep = s.timeStep;
+  return v;
+}
+
+std::string VariantSettings::describe() const {
+  std::string out;
+  auto add = [&](const std::string& kv) { out += (out.empty() ? "" : " ") + kv; };
+  if (scalar) add(std::string("scalar=") + scalarName(*scalar));
+  if (interpolation) add("interp=" + std::to_string(*interpolation));
+  if (broadphase) add(std::string("broadphase=") + broadphaseName(*broadphase));
+  if (bodyBroadphase) add(std::string("body-broadphase=") + bodyBroadphaseName(*bodyBroadphase));
+  if (timeStep) add("dt=" + timeStep->toString());
+  if (threads) add("threads=" + std::to_string(*threads));
+  return out;
+}
+
+bool VariantSettings::mustBeIdenticalTo(const VariantSettings& reference) const {
+  const VariantSettings mine = over(reference);
+  return mine.scalar == reference.scalar && mine.interpolation == reference.interpolation &&
+         mine.timeStep == reference.timeStep;
+}
+
+}  // namespace sg

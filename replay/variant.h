@@ -1,0 +1,38 @@
+// Variant settings: what a run may change without changing the scenario text (scalar type,
+// interpolation, broad phases, time step, threads). Written "key=value" (comma or space
+// separated); the resolved, complete form is stored in every recording's header.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sim/math/rational.h"
+#include "sim/scenario/scenario.h"
+
+namespace sg {
+
+struct VariantSettings {
+  std::optional<ScalarKind> scalar;
+  std::optional<int> interpolation;               ///< k, 1..4
+  std::optional<ParticleBroadphase> broadphase;   ///< particles vs bodies
+  std::optional<BodyBroadphase> bodyBroadphase;   ///< bodies vs bodies
+  std::optional<Rational> timeStep;               ///< s per tick
+  std::optional<int> threads;                     ///< not part of the state: must be bit-identical
+
+  /// Parses "interp=2", "scalar=fx16,dt=1/120", ...; later keys override earlier ones.
+  /// Throws std::invalid_argument with "key=value: expected ..." on a bad setting.
+  static VariantSettings parse(const std::string& text);
+  /// This on top of `base` (keys set here win).
+  VariantSettings over(const VariantSettings& base) const;
+  void applyTo(Scenario& scenario) const;
+  /// Every setting of a scenario with this variant applied (threads omitted).
+  static VariantSettings resolvedFrom(const Scenario& scenario);
+  /// "scalar=fx32 interp=1 broadphase=grid body-broadphase=brute dt=1/60" (set keys only).
+  std::string describe() const;
+  /// True when the variant cannot change the state (only broad phases and threads differ from
+  /// `reference`): the run must be bit-identical to it.
+  bool mustBeIdenticalTo(const VariantSettings& reference) const;
+};
+
+}  // namespace sg
