@@ -50,7 +50,7 @@ sgr::Header makeHeader(const Scenario& scenario, std::vector<sgr::EmbeddedFile> 
 
 Recorder::Recorder(const std::string& path, const Scenario& scenario, std::vector<sgr::EmbeddedFile> files,
                    SimWorld& world, const RecordSettings& settings)
-    : world_(world), settings_(settings), writer_(path, makeHeader(scenario, std::move(files), world, settings)) {
+    : world_(world), settings_(settings), startTick_(world.tick()), writer_(path, makeHeader(scenario, std::move(files), world, settings)) {
   writer_.zstdLevel = settings.zstdLevel;
 }
 
@@ -60,9 +60,10 @@ StepResult Recorder::step(const TickInput& input, StageObserver* observer) {
   writer_.input(world_.tick(), input);
   StepResult r = world_.step(input, observer);
   if (r.ok) {
-    const int64_t t = world_.tick();
-    const bool check = settings_.checkEvery > 0 && t % settings_.checkEvery == 0;
-    const bool snap = settings_.snapshotEvery > 0 && t % settings_.snapshotEvery == 0;
+    // On the grid startTick + n * every (the reader insists on it: a missing chunk is damage).
+    const int64_t t = world_.tick(), since = t - startTick_;
+    const bool check = settings_.checkEvery > 0 && since % settings_.checkEvery == 0;
+    const bool snap = settings_.snapshotEvery > 0 && since % settings_.snapshotEvery == 0;
     if (snap) {
       const std::vector<uint8_t> state = world_.saveState();
       const uint64_t hash = world_.stateHash();

@@ -42,6 +42,7 @@ class Recorder {
  private:
   SimWorld& world_;
   RecordSettings settings_;
+  int64_t startTick_;
   sgr::Writer writer_;
   bool finished_ = false;
 };

@@ -161,6 +161,49 @@ TEST(RecordReplay, OnlyChangedInputIsWritten) {
   EXPECT_TRUE(Player(r).verify().ok);
 }
 
+/// A recording assembled chunk by chunk (valid checksums), to test the reader's consistency rules.
+std::vector<uint8_t> assemble(const std::vector<std::pair<sgr::ChunkType, std::vector<uint8_t>>>& chunks) {
+  std::vector<uint8_t> out(std::begin(sgr::kMagic), std::end(sgr::kMagic));
+  const uint32_t version = sgr::kFormatVersion;
+  out.insert(out.end(), reinterpret_cast<const uint8_t*>(&version), reinterpret_cast<const uint8_t*>(&version) + 4);
+  for (const auto& [type, payload] : chunks) {
+    const std::vector<uint8_t> c = sgr::frameChunk(type, payload);
+    out.insert(out.end(), c.begin(), c.end());
+  }
+  return out;
+}
+
+std::string readerError(std::vector<uint8_t> bytes) {
+  try {
+    sgr::parseRecording(std::move(bytes), "x.sgr");
+  } catch (const sgr::RecordingError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(RecordingReader, ChecksMustFollowTheirIntervalAndEndMustBeCoveredByThem) {
+  sgr::Header h;
+  h.checkEvery = 2;
+  h.snapshotEvery = 0;
+  h.variant = "scalar=fx32";
+  h.scenarioHash = XXH3_64bits("", 0);
+  using T = sgr::ChunkType;
+  const auto head = std::make_pair(T::Head, sgr::encodeHead(h));
+  auto check = [](int64_t t) { return std::make_pair(T::Check, sgr::encodeCheck({t, 7})); };
+  auto end = [](int64_t t) { return std::make_pair(T::End, sgr::encodeEnd({t, 7, false, ""})); };
+  EXPECT_EQ(readerError(assemble({head, check(2), check(4), end(5)})), "no error");
+  // A missing CHCK (tick 4 dropped) is damage, not a shorter recording.
+  EXPECT_NE(readerError(assemble({head, check(2), check(6)})).find("expected the check of tick 4, got tick 6"), std::string::npos);
+  // An END far beyond the last check would make a replay run for ever.
+  EXPECT_NE(readerError(assemble({head, check(2), end(1000000000000)})).find("a final tick from 2 to before the next check at 4"),
+            std::string::npos);
+  EXPECT_NE(readerError(assemble({head, std::make_pair(T::Snapshot, sgr::encodeSnapshot(5, 1, std::vector<uint8_t>(9, 1), 1))}))
+                .find("no SNAP chunk (HEAD says snapshotEvery = 0)"),
+            std::string::npos);
+  EXPECT_NE(readerError(assemble({check(2)})).find("byte 12: expected the HEAD chunk first"), std::string::npos);
+}
+
 TEST(InputTrack, CameraKeysHoldAndCommandsApplyOnTheirTick) {
   const Scenario s = loadScenarioFile(test::sourcePath("scenarios/thesis-bodies.json"));
   const InputTrack track = parseInputTrack(R"({"format": "simgrass-input-track/1", "ticks": 30,

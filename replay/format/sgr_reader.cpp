@@ -4,6 +4,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <xxhash.h>
 #include <zstd.h>
 
@@ -82,6 +83,13 @@ class Cursor {
   const char* chunk_;
   size_t at_ = 0;
 };
+
+/// The next tick on the grid startTick + n * every after `last` (-1: none yet).
+int64_t nextOnGrid(int64_t last, int64_t startTick, uint32_t every) {
+  const int64_t from = last < 0 ? startTick : last;
+  return every == 0 || from > std::numeric_limits<int64_t>::max() - int64_t(every) ? std::numeric_limits<int64_t>::max()
+                                                                                     : from + int64_t(every);
+}
 
 uint64_t maxPayload(ChunkType t) {
   switch (t) {
@@ -250,9 +258,12 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
         Check k;
         k.tick = c.get<int64_t>("the check tick");
         k.hash = c.get<uint64_t>("the check hash");
-        if (k.tick <= std::max(lastCheck, r.header.startTick))
-          c.fail(at + kChunkHeaderBytes, "a check tick after " + std::to_string(std::max(lastCheck, r.header.startTick)) +
-                                             ", got " + std::to_string(k.tick));
+        // CHCK chunks come exactly every checkEvery ticks: a missing or stray one is damage.
+        const int64_t wantCheck = nextOnGrid(lastCheck, r.header.startTick, r.header.checkEvery);
+        if (r.header.checkEvery == 0 || k.tick != wantCheck)
+          c.fail(at + kChunkHeaderBytes, r.header.checkEvery == 0 ? std::string("no CHCK chunk (HEAD says checkEvery = 0)")
+                                                                  : "the check of tick " + std::to_string(wantCheck) +
+                                                                        ", got tick " + std::to_string(k.tick));
         lastCheck = k.tick;
         r.checks.push_back(k);
         c.finished();
@@ -264,10 +275,12 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
         s.hash = c.get<uint64_t>("the snapshot hash");
         const uint64_t rawAt = c.offset();
         s.rawBytes = c.get<uint64_t>("the snapshot size");
-        if (s.tick <= std::max(lastSnapshot, r.header.startTick))
-          c.fail(at + kChunkHeaderBytes, "a snapshot tick after " +
-                                             std::to_string(std::max(lastSnapshot, r.header.startTick)) + ", got " +
-                                             std::to_string(s.tick));
+        const int64_t wantSnapshot = nextOnGrid(lastSnapshot, r.header.startTick, r.header.snapshotEvery);
+        if (r.header.snapshotEvery == 0 || s.tick != wantSnapshot)
+          c.fail(at + kChunkHeaderBytes, r.header.snapshotEvery == 0
+                                             ? std::string("no SNAP chunk (HEAD says snapshotEvery = 0)")
+                                             : "the snapshot of tick " + std::to_string(wantSnapshot) + ", got tick " +
+                                                   std::to_string(s.tick));
         if (s.rawBytes == 0 || s.rawBytes > kMaxSnapshotRawBytes)
           c.fail(rawAt, "a snapshot size between 1 and " + std::to_string(kMaxSnapshotRawBytes) + " bytes, got " +
                             std::to_string(s.rawBytes));
@@ -289,8 +302,13 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
         c.finished();
         const int64_t covered = std::max({r.header.startTick, lastCheck, lastSnapshot,
                                           r.inputs.empty() ? int64_t(0) : r.inputs.back().tick + 1});
-        if (e.tick < covered)
-          c.fail(at + kChunkHeaderBytes, "a final tick >= " + std::to_string(covered) + ", got " + std::to_string(e.tick));
+        // Bounded above too: a recording hashes at least every checkEvery ticks, so a final tick
+        // beyond the next check would have had one (and would make a replay run for ever).
+        const int64_t nextCheck = r.header.checkEvery ? nextOnGrid(lastCheck, r.header.startTick, r.header.checkEvery)
+                                                      : std::numeric_limits<int64_t>::max();
+        if (e.tick < covered || e.tick >= nextCheck + (e.faulted ? 1 : 0))
+          c.fail(at + kChunkHeaderBytes, "a final tick from " + std::to_string(covered) + " to before the next check at " +
+                                             std::to_string(nextCheck) + ", got " + std::to_string(e.tick));
         r.end = e;
         break;
       }
