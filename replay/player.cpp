@@ -45,7 +45,9 @@ Player::Player(const sgr::Recording& recording, int threads, const VariantSettin
   const VariantSettings recorded = VariantSettings::parse(recording.header.variant);
   sameSettings_ = variant.mustBeIdenticalTo(recorded);
   try {
-    world_ = makeWorld(scenario_, threads_);
+    // The machine's memory is the budget (as for `simgrass record`): a recording whose scenario
+    // asks for more is an error here, not a failed allocation later.
+    world_ = makeWorld(scenario_, threads_, physicalMemoryBytes());
   } catch (const ScenarioError& e) {
     throw sgr::RecordingError(recording.file, sgr::kPreambleBytes, std::string("a scenario this build can run: ") + e.what());
   }
@@ -114,6 +116,11 @@ VerifyReport Player::verify(const std::function<void(int64_t)>& progress) {
   if (recording_.end && !recording_.end->faulted) expected.push_back({recording_.end->tick, recording_.end->hash});
   std::stable_sort(expected.begin(), expected.end(), [](const sgr::Check& a, const sgr::Check& b) { return a.tick < b.tick; });
   size_t next = 0;
+  // Snapshots are what seeking restores, and their hash (checked above) says nothing about their
+  // bytes: each must decompress (a damaged frame throws RecordingError) and, when this world runs
+  // with exactly the recorded settings, hold the state replayed at its tick.
+  const bool exactSettings = VariantSettings::resolvedFrom(scenario_).describe() == recording_.header.variant;
+  size_t nextSnapshot = 0;
   while (world_->tick() < last) {
     StepResult r = stepForward();
     if (!r.ok) {
@@ -138,6 +145,15 @@ VerifyReport Player::verify(const std::function<void(int64_t)>& progress) {
         return report;
       }
       ++report.checksVerified;
+    }
+    const std::vector<sgr::SnapshotInfo>& snapshots = recording_.snapshots;
+    while (nextSnapshot < snapshots.size() && snapshots[nextSnapshot].tick < world_->tick()) ++nextSnapshot;
+    if (nextSnapshot < snapshots.size() && snapshots[nextSnapshot].tick == world_->tick()) {
+      const sgr::SnapshotInfo& snap = snapshots[nextSnapshot];
+      const std::vector<uint8_t> state = recording_.snapshotState(snap);
+      if (exactSettings && state != world_->saveState())
+        throw sgr::RecordingError(recording_.file, snap.offset,
+                                  "a snapshot holding the state replayed at tick " + std::to_string(snap.tick));
     }
     if (progress) progress(report.ticks);
   }

@@ -45,7 +45,9 @@ class Player {
   /// before it (or restarts from the start) unless stepping on from the current tick is shorter.
   /// Returns the fault when a step fails. Throws sgr::RecordingError for a damaged snapshot.
   StepResult seek(int64_t tick, const std::function<void(int64_t)>& progress = {});
-  /// Replays from the start to the end, comparing every CHCK, SNAP and END hash.
+  /// Replays from the start to the end, comparing every CHCK, SNAP and END hash; each snapshot is
+  /// also decompressed (and, under the recorded settings, compared byte for byte with the replayed
+  /// state). Throws sgr::RecordingError for a damaged snapshot.
   VerifyReport verify(const std::function<void(int64_t)>& progress = {});
 
  private:

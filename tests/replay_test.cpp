@@ -3,6 +3,7 @@
 // scenarios/recordings/ still replay to their committed hashes.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -163,9 +164,9 @@ TEST(RecordReplay, OnlyChangedInputIsWritten) {
 
 /// A recording assembled chunk by chunk (valid checksums), to test the reader's consistency rules.
 std::vector<uint8_t> assemble(const std::vector<std::pair<sgr::ChunkType, std::vector<uint8_t>>>& chunks) {
-  std::vector<uint8_t> out(std::begin(sgr::kMagic), std::end(sgr::kMagic));
-  const uint32_t version = sgr::kFormatVersion;
-  out.insert(out.end(), reinterpret_cast<const uint8_t*>(&version), reinterpret_cast<const uint8_t*>(&version) + 4);
+  std::vector<uint8_t> out(sgr::kPreambleBytes);
+  std::memcpy(out.data(), sgr::kMagic, sizeof sgr::kMagic);
+  std::memcpy(out.data() + sizeof sgr::kMagic, &sgr::kFormatVersion, 4);
   for (const auto& [type, payload] : chunks) {
     const std::vector<uint8_t> c = sgr::frameChunk(type, payload);
     out.insert(out.end(), c.begin(), c.end());
@@ -320,8 +321,9 @@ TEST(ReplayCli, RecordWithAnInputTrackAndAVariant) {
   const std::string track = dir.write("track.json", R"({"format": "simgrass-input-track/1", "ticks": 25,
       "camera": [{"tick": 0, "position": [0, 2, 5]}],
       "commands": [{"tick": 2, "body": "football", "command": "addVelocity", "value": [2, 0, 0]}]})");
-  const CliResult rec = runCli("record " + quote(test::sourcePath("scenarios/thesis-bodies.json")) + " -o " +
-                               quote(dir.file("t.sgr")) + " --input " + quote(track) + " --variant interp=2 --json");
+  // --variant before the scenario: it takes one value, the path stays the scenario.
+  const CliResult rec = runCli("record --variant interp=2 " + quote(test::sourcePath("scenarios/thesis-bodies.json")) +
+                               " -o " + quote(dir.file("t.sgr")) + " --input " + quote(track) + " --json");
   ASSERT_EQ(rec.exitCode, 0) << rec.describe();
   EXPECT_EQ(parseJson(rec)["ticks"], 25);
   EXPECT_NE(parseJson(rec)["variant"].get<std::string>().find("interp=2"), std::string::npos);

@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <string>
 
+#include "replay/cli/compare_command.h"
+#include "replay/cli/diff_command.h"
 #include "replay/cli/record_command.h"
 #include "replay/cli/replay_command.h"
 #include "replay/cli/run_command.h"
@@ -15,6 +17,8 @@ int main(int argc, char** argv) {
   sg::addRunCommand(app, &exitCode);
   sg::addRecordCommand(app, &exitCode);
   sg::addReplayCommand(app, &exitCode);
+  sg::addDiffCommand(app, &exitCode);
+  sg::addCompareCommand(app, &exitCode);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

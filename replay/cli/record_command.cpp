@@ -120,7 +120,8 @@ void addRecordCommand(CLI::App& app, int* exitCode) {
       ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
   cmd->add_option("--input", o->inputTrack, "Input-track JSON (camera keys and body commands) instead of the scenario's script");
   cmd->add_option("--variant", o->variants, "Settings over the scenario: scalar=fx16, interp=2, broadphase=brute, "
-                                            "body-broadphase=sap, dt=1/120 (repeatable)");
+                                            "body-broadphase=sap, dt=1/120 (repeatable)")
+      ->allow_extra_args(false);  // one value per --variant: a scenario path after it stays the scenario
   cmd->add_option("--threads", o->threads, "Worker threads (the recording is identical for any count)")->check(CLI::Range(1, 256));
   cmd->add_option("--check-every", o->checkEvery, "Ticks between state hashes (default: 1 up to ~130,000 patches)")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 30));

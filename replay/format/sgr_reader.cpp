@@ -286,6 +286,13 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
                             std::to_string(s.rawBytes));
         s.offset = c.offset();
         s.compressedBytes = c.remaining();
+        // zstd cannot expand more than this (each block has a 3-byte header and holds at most
+        // 128 KiB): a larger size would make snapshotState allocate for a state that is not there.
+        const uint64_t canHold = (s.compressedBytes / 3 + 1) * (uint64_t(128) << 10);
+        if (s.rawBytes > canHold)
+          c.fail(rawAt, "a snapshot size that " + std::to_string(s.compressedBytes) +
+                            " compressed bytes can hold (at most " + std::to_string(canHold) + "), got " +
+                            std::to_string(s.rawBytes));
         lastSnapshot = s.tick;
         r.snapshots.push_back(s);
         break;
@@ -300,13 +307,17 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
         e.faulted = faulted == 1;
         e.message = c.string("the fault message", 4096);
         c.finished();
-        const int64_t covered = std::max({r.header.startTick, lastCheck, lastSnapshot,
-                                          r.inputs.empty() ? int64_t(0) : r.inputs.back().tick + 1});
+        constexpr int64_t kMaxTick = std::numeric_limits<int64_t>::max();
+        const int64_t covered =
+            std::max({r.header.startTick, lastCheck, lastSnapshot,
+                      r.inputs.empty() ? int64_t(0) : std::min(r.inputs.back().tick, kMaxTick - 1) + 1});
         // Bounded above too: a recording hashes at least every checkEvery ticks, so a final tick
         // beyond the next check would have had one (and would make a replay run for ever).
         const int64_t nextCheck = r.header.checkEvery ? nextOnGrid(lastCheck, r.header.startTick, r.header.checkEvery)
                                                       : std::numeric_limits<int64_t>::max();
-        if (e.tick < covered || e.tick >= nextCheck + (e.faulted ? 1 : 0))
+        // (A faulted END is replayed one step further: its tick must leave room for that step.)
+        const int64_t lastAllowed = std::min(e.faulted ? nextCheck : nextCheck - 1, kMaxTick - 1);
+        if (e.tick < covered || e.tick > lastAllowed)
           c.fail(at + kChunkHeaderBytes, "a final tick from " + std::to_string(covered) + " to before the next check at " +
                                              std::to_string(nextCheck) + ", got " + std::to_string(e.tick));
         r.end = e;
