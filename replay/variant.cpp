@@ -22,7 +22,7 @@ VariantSettings VariantSettings::parse(const std::string& text) {
   while (in >> item) {
     const size_t eq = item.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
-      bad(item, "key=value with a key scalar, interp, broadphase, body-broadphase, dt or threads");
+      bad(item, "key=value with a key scalar, interp, broadphase, body-broadphase, dt, lod or threads");
     const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
     if (key == "scalar") {
       const auto kind = parseScalarKind(value);
@@ -55,9 +55,11 @@ VariantSettings VariantSettings::parse(const std::string& text) {
       if (n < 1 || n > 256) bad(item, "threads=1..256");
       v.threads = n;
     } else if (key == "lod") {
-      bad(item, "a setting this build has (the level-of-detail window is not implemented yet)");
+      if (value == "off") v.lod = LodMode::Off;
+      else if (value == "window") v.lod = LodMode::Window;
+      else bad(item, "lod=off or window");
     } else {
-      bad(item, "a key scalar, interp, broadphase, body-broadphase, dt or threads");
+      bad(item, "a key scalar, interp, broadphase, body-broadphase, dt, lod or threads");
     }
   }
   return v;
@@ -71,6 +73,7 @@ VariantSettings VariantSettings::over(const VariantSettings& base) const {
   if (bodyBroadphase) v.bodyBroadphase = bodyBroadphase;
   if (timeStep) v.timeStep = timeStep;
   if (threads) v.threads = threads;
+  if (lod) v.lod = lod;
   return v;
 }
 
@@ -80,6 +83,7 @@ void VariantSettings::applyTo(Scenario& s) const {
   if (broadphase) s.bodies.particleBroadphase = *broadphase;
   if (bodyBroadphase) s.bodies.bodyBroadphase = *bodyBroadphase;
   if (timeStep) s.timeStep = *timeStep;
+  if (lod) s.lod.mode = *lod;
 }
 
 VariantSettings VariantSettings::resolvedFrom(const Scenario& s) {
@@ -89,6 +93,7 @@ VariantSettings VariantSettings::resolvedFrom(const Scenario& s) {
   v.broadphase = s.bodies.particleBroadphase;
   v.bodyBroadphase = s.bodies.bodyBroadphase;
   v.timeStep = s.timeStep;
+  if (s.lod.mode == LodMode::Window) v.lod = LodMode::Window;  // off is the default: not written
   return v;
 }
 
@@ -100,6 +105,7 @@ std::string VariantSettings::describe() const {
   if (broadphase) add(std::string("broadphase=") + broadphaseName(*broadphase));
   if (bodyBroadphase) add(std::string("body-broadphase=") + bodyBroadphaseName(*bodyBroadphase));
   if (timeStep) add("dt=" + timeStep->toString());
+  if (lod) add(std::string("lod=") + (*lod == LodMode::Window ? "window" : "off"));
   if (threads) add("threads=" + std::to_string(*threads));
   return out;
 }
@@ -107,7 +113,7 @@ std::string VariantSettings::describe() const {
 bool VariantSettings::mustBeIdenticalTo(const VariantSettings& reference) const {
   const VariantSettings mine = over(reference);
   return mine.scalar == reference.scalar && mine.interpolation == reference.interpolation &&
-         mine.timeStep == reference.timeStep;
+         mine.timeStep == reference.timeStep && mine.lod.value_or(LodMode::Off) == reference.lod.value_or(LodMode::Off);
 }
 
 }  // namespace sg

@@ -19,6 +19,7 @@ struct VariantSettings {
   std::optional<BodyBroadphase> bodyBroadphase;   ///< bodies vs bodies
   std::optional<Rational> timeStep;               ///< s per tick
   std::optional<int> threads;                     ///< not part of the state: must be bit-identical
+  std::optional<LodMode> lod;                     ///< off: the whole field; window: around the camera
 
   /// Parses "interp=2", "scalar=fx16,dt=1/120", ...; later keys override earlier ones.
   /// Throws std::invalid_argument with "key=value: expected ..." on a bad setting.

@@ -248,7 +248,7 @@ TEST(Variant, ParsesDescribesAndOverrides) {
   EXPECT_FALSE(VariantSettings::parse("interp=2").mustBeIdenticalTo(base));
   EXPECT_FALSE(VariantSettings::parse("dt=1/120").mustBeIdenticalTo(base));
   EXPECT_TRUE(VariantSettings::parse("scalar=fx32").mustBeIdenticalTo(base));
-  for (const char* bad : {"interp=5", "scalar=q8", "dt=0", "dt=2", "threads=0", "lod=off", "speed=3", "interp"}) {
+  for (const char* bad : {"interp=5", "scalar=q8", "dt=0", "dt=2", "threads=0", "lod=maybe", "speed=3", "interp"}) {
     EXPECT_THROW(VariantSettings::parse(bad), std::invalid_argument) << bad;
   }
   try {

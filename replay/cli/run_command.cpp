@@ -23,6 +23,7 @@ struct RunOptions {
   int64_t hashEvery = 0;
   std::string broadphase;      // particles vs bodies: grid | brute
   std::string bodyBroadphase;  // bodies vs bodies: brute | sap
+  std::string lod;             // off | window
   bool json = false;
 };
 
@@ -43,6 +44,7 @@ int runScenario(const RunOptions& o) {
       scenario.bodies.particleBroadphase = o.broadphase == "brute" ? ParticleBroadphase::Brute : ParticleBroadphase::Grid;
     if (!o.bodyBroadphase.empty())
       scenario.bodies.bodyBroadphase = o.bodyBroadphase == "sap" ? BodyBroadphase::SweepAndPrune : BodyBroadphase::Brute;
+    if (!o.lod.empty()) scenario.lod.mode = o.lod == "window" ? LodMode::Window : LodMode::Off;
     world = makeWorld(scenario, o.threads, physicalMemoryBytes());
   } catch (const ScenarioError& e) {
     std::fprintf(stderr, "simgrass run: %s\n", e.what());
@@ -92,6 +94,9 @@ int runScenario(const RunOptions& o) {
     j["counts"] = {{"patchesX", counts.patchesX}, {"patchesZ", counts.patchesZ}, {"patches", counts.patches()},
                    {"particlesX", counts.particlesX}, {"particlesZ", counts.particlesZ},
                    {"particles", counts.particles()}, {"bodies", counts.bodies}, {"contacts", counts.contacts}};
+    if (counts.lodWindow)
+      j["lod"] = {{"windowPatchesX", counts.windowPatchesX}, {"windowPatchesZ", counts.windowPatchesZ},
+                  {"originI", counts.windowOriginI}, {"originJ", counts.windowOriginJ}};
     j["ticks"] = ran;
     j["finalHash"] = hex(finalHash);
     if (o.hashEvery > 0) j["hashes"] = hashes;
@@ -109,6 +114,11 @@ int runScenario(const RunOptions& o) {
     std::printf("patches    %" PRId64 " (%" PRId64 " x %" PRId64 "), particles %" PRId64 " (%" PRId64 " x %" PRId64 ")\n",
                 counts.patches(), counts.patchesX, counts.patchesZ, counts.particles(), counts.particlesX,
                 counts.particlesZ);
+    if (counts.lodWindow) {
+      const WorldCounts now = world->counts();
+      std::printf("lod        window of %" PRId64 " x %" PRId64 " patches, at patch (%" PRId64 ", %" PRId64 ") after the last tick\n",
+                  now.windowPatchesX, now.windowPatchesZ, now.windowOriginI, now.windowOriginJ);
+    }
     if (counts.bodies > 0)
       std::printf("bodies     %" PRId64 ", %" PRId64 " contacts in the last tick\n", counts.bodies, counts.contacts);
     std::printf("ticks      %" PRId64 " (%.3f s simulated at dt = %s s)\n", ran,
@@ -146,6 +156,8 @@ void addRunCommand(CLI::App& app, int* exitCode) {
       ->check(CLI::IsMember({"grid", "brute"}));
   run->add_option("--body-broadphase", opts->bodyBroadphase, "Body-vs-body broad phase (the state is identical)")
       ->check(CLI::IsMember({"brute", "sap"}));
+  run->add_option("--lod", opts->lod, "Level of detail: off (the whole field) or window (around the camera)")
+      ->check(CLI::IsMember({"off", "window"}));
   run->add_flag("--json", opts->json, "Machine-readable output");
   run->callback([opts, exitCode] { *exitCode = runScenario(*opts); });
 }

@@ -13,15 +13,17 @@ std::vector<ParticleRange> particleRanges(const std::vector<RigidBody<S>>& bodie
   for (const RigidBody<S>& body : bodies)
     for (size_t p = 0; p < body.parts.size(); ++p) {
       ParticleRange r;
+      // Lattice particle coordinates, clipped to the held window.
+      const LatticeWindow& w = grid.window;
       if (s.broadphase == ParticleBroadphase::Brute) {
-        r = {0, grid.countX - 1, 0, grid.countZ - 1};
+        r = {w.originI, w.endI() - 1, w.originJ, w.endJ() - 1};
       } else {
         const Vec3<S> c = body.partPose(p).position;
         const S reach = body.parts[p].boundingRadius + s.margin;
-        r.a0 = std::max<int64_t>(0, floorToInt((c.x() - reach - s.anchorOriginX) * s.invParticleSpacing));
-        r.a1 = std::min<int64_t>(grid.countX - 1, floorToInt((c.x() + reach - s.anchorOriginX) * s.invParticleSpacing) + 1);
-        r.b0 = std::max<int64_t>(0, floorToInt((c.z() - reach - s.anchorOriginZ) * s.invParticleSpacing));
-        r.b1 = std::min<int64_t>(grid.countZ - 1, floorToInt((c.z() + reach - s.anchorOriginZ) * s.invParticleSpacing) + 1);
+        r.a0 = std::max<int64_t>(w.originI, floorToInt((c.x() - reach - s.anchorOriginX) * s.invParticleSpacing));
+        r.a1 = std::min<int64_t>(w.endI() - 1, floorToInt((c.x() + reach - s.anchorOriginX) * s.invParticleSpacing) + 1);
+        r.b0 = std::max<int64_t>(w.originJ, floorToInt((c.z() - reach - s.anchorOriginZ) * s.invParticleSpacing));
+        r.b1 = std::min<int64_t>(w.endJ() - 1, floorToInt((c.z() + reach - s.anchorOriginZ) * s.invParticleSpacing) + 1);
       }
       out.push_back(r);
     }
@@ -41,10 +43,13 @@ int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid
       const ParticleRange& r = ranges[rangeIndex];
       const BodyPart<S>& shape = body.parts[part];
       const Pose<S> pose = body.partPose(part);
-      const int64_t b0 = std::max(r.b0, rowBegin), b1 = std::min(r.b1, rowEnd - 1);
-      for (int64_t b = b0; b <= b1; ++b)
-        for (int64_t a = r.a0; a <= r.a1; ++a) {
-          const size_t i = size_t(b * grid.countX + a);
+      // Storage rows [rowBegin, rowEnd): each holds one lattice row of the window.
+      for (int64_t row = rowBegin; row < rowEnd; ++row) {
+        const int64_t b = grid.window.latticeRow(row);
+        if (b < r.b0 || b > r.b1) continue;
+        int64_t column = grid.window.storageColumn(r.a0);
+        for (int64_t a = r.a0; a <= r.a1; ++a, column = column + 1 == grid.countX ? 0 : column + 1) {
+          const size_t i = size_t(row * grid.countX + column);
           const Vec3<S> p(pa.px[i], pa.py[i], pa.pz[i]);
           if (shape.type == ShapeType::Sphere) {
             const Vec3<S> d = p - pose.position;
@@ -78,6 +83,7 @@ int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid
           if (T::faultPending() || !(T::isFinite(pa.px[i]) && T::isFinite(pa.py[i]) && T::isFinite(pa.pz[i])))
             return int64_t(i);
         }
+      }
     }
   }
   return -1;

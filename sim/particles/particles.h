@@ -7,12 +7,18 @@
 #include <cstdint>
 #include <vector>
 
+#include "sim/lod/lattice_window.h"
+
 namespace sg {
 
+/// The simulated particles: a window of the particle lattice (the whole of it with the level of
+/// detail off). Storage is toroidal (sim/lod/lattice_window.h); countX == window.sizeI and
+/// countZ == window.sizeJ always, so the pointwise stages simply run over countX * countZ.
 struct ParticleGrid {
   int k = 1;            ///< patches per particle along each axis
-  int64_t countX = 0;   ///< particles per row (along x)
-  int64_t countZ = 0;   ///< particle rows (along z)
+  int64_t countX = 0;   ///< particles per stored row (along x)
+  int64_t countZ = 0;   ///< stored particle rows (along z)
+  LatticeWindow window; ///< which particles of the field are held, and where
   int64_t size() const { return countX * countZ; }
   /// Particles per axis covering n patches: ceil((n - 1) / k) + 1.
   static int64_t coverCount(int64_t patches, int k) { return (patches - 1 + k - 1) / k + 1; }

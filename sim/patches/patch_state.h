@@ -53,49 +53,58 @@ inline void writePatch(PatchArrays<S>& patches, size_t p, S ddx, S ddy, S ddz, c
   patches.tiltLevel[p] = uint8_t(sink > c.drop[2] ? 3 : sink > c.drop[1] ? 2 : sink > c.drop[0] ? 1 : 0);
 }
 
-/// Derived state of patch row j. `scratch` holds 3 * grid.countX values.
+/// Derived state of patch row j (a lattice row of `patchWindow`) for interpolation k > 1 (with
+/// k = 1 patch and particle storage coincide and writePatch runs straight over them).
+/// `particles` is the particle window (toroidal, sim/lod/lattice_window.h); the patch window
+/// covers patch columns [k originI, k (originI + sizeI - 1)] at most, so every patch lies between
+/// two held particles. `scratch` holds 3 * particles.sizeI values.
 template <class S>
-inline void updatePatchRow(PatchArrays<S>& patches, int64_t patchesX, int64_t j, const ParticleGrid& grid,
-                           const std::vector<S>& dx, const std::vector<S>& dy, const std::vector<S>& dz,
-                           const PatchStateConstants<S>& c, S* scratch) {
+inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWindow, int64_t j,
+                           const LatticeWindow& particles, const std::vector<S>& dx, const std::vector<S>& dy,
+                           const std::vector<S>& dz, const PatchStateConstants<S>& c, S* scratch) {
   const int k = c.k;
   const int64_t b0 = j / k, tz = j % k;
-  const int64_t nx = grid.countX;
-  // Row of displacements at this patch row's z: particle row b0, or a blend of b0 and b0+1.
-  const S* rx = dx.data() + b0 * nx;
-  const S* ry = dy.data() + b0 * nx;
-  const S* rz = dz.data() + b0 * nx;
+  const int64_t nx = particles.sizeI;
+  // Row of displacements at this patch row's z: particle row b0, or a blend of b0 and b0+1, in
+  // storage column order (the blend is per column, so no remapping is needed yet).
+  const int64_t r0 = particles.storageRow(b0) * nx;
+  const S* rx = dx.data() + r0;
+  const S* ry = dy.data() + r0;
+  const S* rz = dz.data() + r0;
   if (tz != 0) {
+    const int64_t r1 = particles.storageRow(b0 + 1) * nx;
     const S w = c.weight[size_t(tz)];
     S* bx = scratch;
     S* by = scratch + nx;
     S* bz = scratch + 2 * nx;
     for (int64_t a = 0; a < nx; ++a) {
-      bx[a] = lerp(rx[a], rx[a + nx], w);
-      by[a] = lerp(ry[a], ry[a + nx], w);
-      bz[a] = lerp(rz[a], rz[a + nx], w);
+      bx[a] = lerp(rx[a], dx[size_t(r1 + a)], w);
+      by[a] = lerp(ry[a], dy[size_t(r1 + a)], w);
+      bz[a] = lerp(rz[a], dz[size_t(r1 + a)], w);
     }
     rx = bx;
     ry = by;
     rz = bz;
   }
-  const int64_t row = j * patchesX;
-  if (k == 1) {  // every patch owns its particle
-    for (int64_t i = 0; i < patchesX; ++i) writePatch(patches, size_t(row + i), rx[i], ry[i], rz[i], c);
-    return;
-  }
-  // Walk particle columns a and the k patches after each (i = a k + t): no division per patch.
-  for (int64_t a = 0, i = 0; i < patchesX; ++a) {
-    for (int t = 0; t < k && i < patchesX; ++t, ++i) {
-      S ddx = rx[a], ddy = ry[a], ddz = rz[a];
+  // Walk particle columns (storage column sa, wrapping) and the k patches after each
+  // (i = k a + t): no division per patch. Patch storage columns wrap the same way.
+  const int64_t rowBase = patchWindow.storageRow(j) * patchWindow.sizeI;
+  int64_t sa = particles.storageColumn(patchWindow.originI / k);
+  int64_t sp = patchWindow.storageColumn(patchWindow.originI);
+  for (int64_t i = patchWindow.originI; i < patchWindow.endI();) {
+    const int64_t sb = sa + 1 == nx ? 0 : sa + 1;
+    for (int t = 0; t < k && i < patchWindow.endI(); ++t, ++i) {
+      S ddx = rx[sa], ddy = ry[sa], ddz = rz[sa];
       if (t != 0) {
         const S w = c.weight[size_t(t)];
-        ddx = lerp(ddx, rx[a + 1], w);
-        ddy = lerp(ddy, ry[a + 1], w);
-        ddz = lerp(ddz, rz[a + 1], w);
+        ddx = lerp(ddx, rx[sb], w);
+        ddy = lerp(ddy, ry[sb], w);
+        ddz = lerp(ddz, rz[sb], w);
       }
-      writePatch(patches, size_t(row + i), ddx, ddy, ddz, c);
+      writePatch(patches, size_t(rowBase + sp), ddx, ddy, ddz, c);
+      sp = sp + 1 == patchWindow.sizeI ? 0 : sp + 1;
     }
+    sa = sb;
   }
 }
 

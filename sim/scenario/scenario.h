@@ -72,6 +72,15 @@ enum class BodyCommandKind : uint8_t {
   Impulse,      ///< velocity += value / mass
   Teleport,     ///< position = value, velocities = 0
 };
+/// A camera key of a camera track: the camera sits at `position` from `tick` until the next key.
+struct CameraKey {
+  int64_t tick = 0;
+  Rational3 position{Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
+};
+
+/// Level of detail (thesis §3): simulate only a window of the meadow around the camera.
+enum class LodMode : uint8_t { Off, Window };
+
 struct ScriptedCommand {
   int64_t tick = 0;
   int32_t body = 0;
@@ -155,6 +164,19 @@ struct Scenario {
     Rational length{30, 1}, width{20, 1}, lineWidth{1, 2}, centerCircleRadius{3, 1};
   } markings;
   std::vector<ScriptedCommand> script;  ///< sorted by tick, then body
+  std::vector<CameraKey> camera;         ///< scripted camera track, increasing ticks
+
+  /// Level of detail. Off: the whole field is simulated. Window: W x H particles around the
+  /// camera (level 0), a static edge-grass ring of `edgeRows` rows at `edgeSpacing` x the grass
+  /// spacing around it (level 1), the terrain beyond (level 2). docs/level-of-detail.md.
+  struct Lod {
+    LodMode mode = LodMode::Off;
+    int64_t windowX = 151, windowZ = 151;  ///< particles (clamped to the field)
+    bool centerGiven = false;
+    Rational centerX{0, 1}, centerZ{0, 1};  ///< m, where the window starts (default: the field centre)
+    int edgeSpacing = 4;                    ///< edge-grass spacing as a multiple of the grass spacing
+    int edgeRows = 30;
+  } lod;
 
   std::string sourceName = "<built-in>";  ///< file name for error messages
   std::string text;                       ///< the JSON text it was parsed from
@@ -183,10 +205,6 @@ Scenario parseScenario(const std::string& text, const std::string& sourceName,
 /// An input-track file (docs/scenario-format.md): camera keys and body commands that replace a
 /// scenario's script when recording. Commands name bodies of `scenario` and use the script's
 /// schema; the camera holds each key's position until the next key.
-struct CameraKey {
-  int64_t tick = 0;
-  Rational3 position{Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
-};
 struct InputTrack {
   std::optional<int64_t> ticks;        ///< how long to record, when the track says
   std::vector<CameraKey> camera;       ///< increasing ticks

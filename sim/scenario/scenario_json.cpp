@@ -409,6 +409,38 @@ void parseMarkings(const Reader& r, const json& j, Scenario::Markings& m) {
   if (j.contains("centerCircleRadius")) m.centerCircleRadius = r.nonNegative(j["centerCircleRadius"], p + ".centerCircleRadius");
 }
 
+void parseCamera(const Reader& r, const json& cams, const std::string& p, std::vector<CameraKey>& out) {
+  if (!cams.is_array() || cams.size() > 10000000) r.failGot(p, "an array of {tick, position}", cams);
+  for (size_t i = 0; i < cams.size(); ++i) {
+    const std::string q = p + "[" + std::to_string(i) + "]";
+    r.object(cams[i], q, {"tick", "position"});
+    if (!cams[i].contains("tick")) r.fail(q + ".tick", "the tick the camera moves (missing)");
+    if (!cams[i].contains("position")) r.fail(q + ".position", "a position [x, y, z] (missing)");
+    CameraKey key;
+    key.tick = r.integer(cams[i]["tick"], q + ".tick", 0, int64_t(1) << 40);
+    if (!out.empty() && key.tick <= out.back().tick)
+      r.failGot(q + ".tick", "a tick after the previous camera key's " + std::to_string(out.back().tick), cams[i]["tick"]);
+    key.position = r.vector<3>(cams[i]["position"], q + ".position");
+    out.push_back(key);
+  }
+}
+
+void parseLod(const Reader& r, const json& j, Scenario::Lod& l) {
+  const std::string p = "$.lod";
+  r.object(j, p, {"mode", "window", "center", "edgeSpacing", "edgeRows"});
+  if (j.contains("mode")) l.mode = r.choice<LodMode>(j["mode"], p + ".mode", {{"off", LodMode::Off}, {"window", LodMode::Window}});
+  if (j.contains("window")) {
+    const json& w = j["window"];
+    if (!w.is_array() || w.size() != 2) r.failGot(p + ".window", "[particles along x, particles along z]", w);
+    l.windowX = r.integer(w[0], p + ".window[0]", 3, 1 << 20);
+    l.windowZ = r.integer(w[1], p + ".window[1]", 3, 1 << 20);
+  }
+  if (j.contains("center")) l.centerGiven = true;
+  r.center(j, p, &l.centerX, &l.centerZ);
+  if (j.contains("edgeSpacing")) l.edgeSpacing = int(r.integer(j["edgeSpacing"], p + ".edgeSpacing", 1, 64));
+  if (j.contains("edgeRows")) l.edgeRows = int(r.integer(j["edgeRows"], p + ".edgeRows", 0, 1000));
+}
+
 void parseScript(const Reader& r, const json& j, const Scenario& s, const std::string& p,
                  std::vector<ScriptedCommand>& script) {
   if (!j.is_array() || j.size() > 1000000) r.failGot(p, "an array of commands", j);
@@ -513,7 +545,7 @@ Scenario parseScenario(const std::string& text, const std::string& sourceName, c
   s.sourceName = sourceName;
   s.text = text;
   r.object(root, "$", {"format", "name", "description", "seed", "scalar", "timeStep", "field", "particles", "wind", "terrain",
-                       "bodies", "script", "markings"});
+                       "bodies", "script", "markings", "camera", "lod"});
   if (root.contains("format") && root["format"] != "simgrass-scenario/1")
     r.failGot("$.format", "\"simgrass-scenario/1\"", root["format"]);
   if (root.contains("name")) s.name = r.string(root["name"], "$.name");
@@ -539,6 +571,8 @@ Scenario parseScenario(const std::string& text, const std::string& sourceName, c
   if (root.contains("bodies")) parseBodies(r, root["bodies"], s.bodies);
   if (root.contains("script")) parseScript(r, root["script"], s, "$.script", s.script);
   if (root.contains("markings")) parseMarkings(r, root["markings"], s.markings);
+  if (root.contains("camera")) parseCamera(r, root["camera"], "$.camera", s.camera);
+  if (root.contains("lod")) parseLod(r, root["lod"], s.lod);
   if (s.wind.schedule.empty()) {
     // An empty schedule is allowed: no wind.
   }
@@ -597,22 +631,7 @@ InputTrack parseInputTrack(const std::string& text, const std::string& sourceNam
   if (!root.contains("format") || root["format"] != "simgrass-input-track/1")
     r.failGot("$.format", "\"simgrass-input-track/1\"", root.contains("format") ? root["format"] : json());
   if (root.contains("ticks")) track.ticks = r.integer(root["ticks"], "$.ticks", 0, int64_t(1) << 40);
-  if (root.contains("camera")) {
-    const json& cams = root["camera"];
-    if (!cams.is_array() || cams.size() > 10000000) r.failGot("$.camera", "an array of {tick, position}", cams);
-    for (size_t i = 0; i < cams.size(); ++i) {
-      const std::string q = "$.camera[" + std::to_string(i) + "]";
-      r.object(cams[i], q, {"tick", "position"});
-      if (!cams[i].contains("tick")) r.fail(q + ".tick", "the tick the camera moves (missing)");
-      if (!cams[i].contains("position")) r.fail(q + ".position", "a position [x, y, z] (missing)");
-      CameraKey key;
-      key.tick = r.integer(cams[i]["tick"], q + ".tick", 0, int64_t(1) << 40);
-      if (!track.camera.empty() && key.tick <= track.camera.back().tick)
-        r.failGot(q + ".tick", "a tick after the previous camera key's " + std::to_string(track.camera.back().tick), cams[i]["tick"]);
-      key.position = r.vector<3>(cams[i]["position"], q + ".position");
-      track.camera.push_back(key);
-    }
-  }
+  if (root.contains("camera")) parseCamera(r, root["camera"], "$.camera", track.camera);
   if (root.contains("commands")) parseScript(r, root["commands"], scenario, "$.commands", track.commands);
   return track;
 }

@@ -1,5 +1,6 @@
 // Scalar-specific checks: does this scenario fit the chosen number format and the memory?
 #include <cmath>
+#include <algorithm>
 #include <sstream>
 
 #include "sim/bodies/rigid_body.h"
@@ -38,11 +39,20 @@ void checkResolution(const Scenario& s) {
 uint64_t estimateWorldBytes(const Scenario& s, ScalarKind scalar) {
   const uint64_t sz = scalar == ScalarKind::Fx16 || scalar == ScalarKind::Float ? 4 : 8;
   const uint64_t k = uint64_t(s.particles.interpolation);
-  const uint64_t nx = uint64_t(s.field.patchesX), nz = uint64_t(s.field.patchesZ);
-  const uint64_t px = (nx - 1 + k - 1) / k + 1, pz = (nz - 1 + k - 1) / k + 1;
+  uint64_t nx = uint64_t(s.field.patchesX), nz = uint64_t(s.field.patchesZ);
+  uint64_t px = (nx - 1 + k - 1) / k + 1, pz = (nz - 1 + k - 1) / k + 1;
+  uint64_t ring = 0;
+  if (s.lod.mode == LodMode::Window) {  // only the window is held (and the edge ring)
+    px = std::min<uint64_t>(uint64_t(s.lod.windowX), (nx - 1) / k + 1);
+    pz = std::min<uint64_t>(uint64_t(s.lod.windowZ), (nz - 1) / k + 1);
+    nx = (px - 1) * k + 1;
+    nz = (pz - 1) * k + 1;
+    const uint64_t m = uint64_t(s.lod.edgeSpacing), r = uint64_t(s.lod.edgeRows);
+    ring = (nx / m + 2 + 2 * r) * (nz / m + 2 + 2 * r) * (3 * sz + 4);
+  }
   const uint64_t perPatch = 3 * sz + 3 + 3 * sz + 1;      // root, rotation+variant, derived
   const uint64_t perParticle = 9 * sz + 3 * sz;            // p, v, anchor, displacement
-  return nx * nz * perPatch + px * pz * perParticle;
+  return nx * nz * perPatch + px * pz * perParticle + ring;
 }
 
 void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimitBytes) {

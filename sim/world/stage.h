@@ -7,7 +7,8 @@
 namespace sg {
 
 enum class Stage : uint8_t {
-  Wind = 0,         ///< per-row wind force and particle acceleration        (sim/wind)
+  Window = 0,       ///< level-of-detail window follows the camera           (sim/lod)
+  Wind,             ///< per-row wind force and particle acceleration        (sim/wind)
   Collision,        ///< body-body and body-terrain contacts                 (sim/collision)
   Response,         ///< gravity, contact impulses, projection, grass push   (sim/collision)
   Integrate,        ///< p += v dt; v += a dt; v *= damping^dt              (sim/particles)
@@ -18,6 +19,7 @@ enum class Stage : uint8_t {
 
 inline const char* stageName(Stage s) {
   switch (s) {
+    case Stage::Window: return "window";
     case Stage::Wind: return "wind";
     case Stage::Collision: return "collision";
     case Stage::Response: return "response";

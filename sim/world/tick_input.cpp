@@ -23,22 +23,24 @@ void addCommands(const std::vector<ScriptedCommand>& script, int64_t tick, TickI
   for (auto it = first; it != script.end() && it->tick == tick; ++it)
     input.bodies.push_back(BodyCommand{it->body, it->kind, toInputVec3(it->value)});
 }
+void setCamera(const std::vector<CameraKey>& keys, int64_t tick, TickInput& input) {
+  auto key = std::upper_bound(keys.begin(), keys.end(), tick, [](int64_t t, const CameraKey& k) { return t < k.tick; });
+  if (key == keys.begin()) return;
+  input.hasCamera = true;
+  input.camera = toInputVec3((key - 1)->position);
+}
 }  // namespace
 
 TickInput scriptedInput(const Scenario& scenario, int64_t tick) {
   TickInput input;
+  setCamera(scenario.camera, tick, input);
   addCommands(scenario.script, tick, input);
   return input;
 }
 
 TickInput trackInput(const InputTrack& track, int64_t tick) {
   TickInput input;
-  auto key = std::upper_bound(track.camera.begin(), track.camera.end(), tick,
-                              [](int64_t t, const CameraKey& k) { return t < k.tick; });
-  if (key != track.camera.begin()) {
-    input.hasCamera = true;
-    input.camera = toInputVec3((key - 1)->position);
-  }
+  setCamera(track.camera, tick, input);
   addCommands(track.commands, tick, input);
   return input;
 }

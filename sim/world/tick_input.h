@@ -25,14 +25,14 @@ struct BodyCommand {
 };
 
 struct TickInput {
-  /// Camera position for the level-of-detail window (the LOD issue); ignored until then.
+  /// Camera position: the level-of-detail window follows it (ignored with the level of detail off).
   bool hasCamera = false;
   InputVec3 camera;
   std::vector<BodyCommand> bodies;  ///< applied in order
   friend bool operator==(const TickInput&, const TickInput&) = default;
 };
 
-/// The scenario's scripted commands for one tick (empty when it has none).
+/// The scenario's scripted input for one tick: its camera track and its script (empty when it has none).
 TickInput scriptedInput(const Scenario& scenario, int64_t tick);
 
 /// An input track's input for one tick: the latest camera key at or before it, that tick's commands.

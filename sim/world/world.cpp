@@ -59,6 +59,12 @@ uint64_t scenarioFingerprint(const Scenario& s) {
     hashRational(h, g.duration);
   }
   h.write(s.terrain.heightmap.samples.data(), s.terrain.heightmap.samples.size());
+  if (s.lod.mode == LodMode::Window) {  // worlds without the window keep their fingerprint
+    const int64_t lod[] = {1, s.lod.windowX, s.lod.windowZ, s.lod.edgeSpacing, s.lod.edgeRows, s.lod.centerGiven ? 1 : 0};
+    h.write(lod, sizeof lod);
+    hashRational(h, s.lod.centerX);
+    hashRational(h, s.lod.centerZ);
+  }
   if (!s.bodies.list.empty()) {  // worlds without bodies keep the fingerprint they always had
     const auto& b = s.bodies;
     // Not the broad phases: they are promised to give the same state, so they must not change it.
@@ -120,8 +126,26 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   terrain_ = Terrain<S>(s.terrain, c);
 
   grid_.k = k;
-  grid_.countX = c.particlesX;
-  grid_.countZ = c.particlesZ;
+  lodWindow_ = s.lod.mode == LodMode::Window;
+  grid_.window.fieldI = c.particlesX;
+  grid_.window.fieldJ = c.particlesZ;
+  patchWindow_.fieldI = f.patchesX;
+  patchWindow_.fieldJ = f.patchesZ;
+  if (lodWindow_) {
+    // A window keeps every patch it holds between two held particles: it spans at most the
+    // particles whose patch (k a, k b) lies in the field, and holds patches k I0 .. k (I0+W-1).
+    grid_.countX = std::min(s.lod.windowX, (f.patchesX - 1) / k + 1);
+    grid_.countZ = std::min(s.lod.windowZ, (f.patchesZ - 1) / k + 1);
+    patchWindow_.sizeI = (grid_.countX - 1) * k + 1;
+    patchWindow_.sizeJ = (grid_.countZ - 1) * k + 1;
+  } else {
+    grid_.countX = c.particlesX;
+    grid_.countZ = c.particlesZ;
+    patchWindow_.sizeI = f.patchesX;
+    patchWindow_.sizeJ = f.patchesZ;
+  }
+  grid_.window.sizeI = grid_.countX;
+  grid_.window.sizeJ = grid_.countZ;
 
   particleConsts_.dt = toS<S>(s.timeStep);
   particleConsts_.invDt = toS<S>(c.invDt);
@@ -185,8 +209,9 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   bodyParticle_.anchorOriginZ = lattice_.originZ;
   bodyParticle_.invParticleSpacing = toS<S>(c.invParticleSpacing);
 
-  // Patches: static attributes from the lattice hash, roots on the terrain.
-  const size_t nPatches = size_t(f.patchesX * f.patchesZ);
+  // Patches and particles of the window: static attributes from the lattice hash, roots on the
+  // terrain, particles at rest length straight up with the scenario's initial velocity.
+  const size_t nPatches = size_t(patchWindow_.size());
   for (auto* v : {&patches_.rootX, &patches_.rootY, &patches_.rootZ, &patches_.tipOffsetX, &patches_.tipOffsetZ,
                   &patches_.topY})
     v->assign(nPatches, S(0));
@@ -194,42 +219,18 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   patches_.variant.assign(nPatches, 0);
   patches_.cut.assign(nPatches, 0);
   patches_.tiltLevel.assign(nPatches, 0);
-  const int64_t patchRowsPerChunk = std::max<int64_t>(1, kTargetChunkElements / f.patchesX);
-  pool_->run((f.patchesZ + patchRowsPerChunk - 1) / patchRowsPerChunk, [&](int64_t c, int) {
-    const int64_t j1 = std::min(f.patchesZ, (c + 1) * patchRowsPerChunk);
-    for (int64_t j = c * patchRowsPerChunk; j < j1; ++j)
-      for (int64_t i = 0; i < f.patchesX; ++i) {
-        const size_t p = size_t(j * f.patchesX + i);
-        lattice_.rootXZ(i, j, &patches_.rootX[p], &patches_.rootZ[p]);
-        patches_.rootY[p] = terrain_.heightAt(patches_.rootX[p], patches_.rootZ[p]);
-        patches_.rotation[p] = lattice_.rotation(i, j);
-        patches_.variant[p] = lattice_.variant(i, j);
-        // Markings use the un-jittered lattice point: straight lines despite the jitter.
-        if (markings_.onLine(lattice_.originX + mulInt(lattice_.spacing, i), lattice_.originZ + mulInt(lattice_.spacing, j)))
-          patches_.variant[p] = uint8_t(lattice_.atlasVariants);
-      }
-  });
-
-  // Particles: anchored at the root of patch (k a, k b), starting at rest length straight up.
   particles_.resize(size_t(grid_.size()));
-  const S v0x = toS<S>(s.particles.initialVelocity[0]), v0y = toS<S>(s.particles.initialVelocity[1]),
-          v0z = toS<S>(s.particles.initialVelocity[2]);
-  for (int64_t b = 0; b < grid_.countZ; ++b)
-    for (int64_t a = 0; a < grid_.countX; ++a) {
-      const size_t q = size_t(b * grid_.countX + a);
-      S x, z;
-      lattice_.rootXZ(a * k, b * k, &x, &z);
-      const S y = terrain_.heightAt(x, z);
-      particles_.anchorX[q] = x;
-      particles_.anchorY[q] = y;
-      particles_.anchorZ[q] = z;
-      particles_.px[q] = x;
-      particles_.py[q] = y + particleConsts_.rodLength;
-      particles_.pz[q] = z;
-      particles_.vx[q] = v0x;
-      particles_.vy[q] = v0y;
-      particles_.vz[q] = v0z;
-    }
+  int64_t startI = 0, startJ = 0;
+  edgeRing_.configure(lattice_, s.lod.edgeSpacing, lodWindow_ ? s.lod.edgeRows : 0);
+  initialVelocity_ = Vec3<S>(toS<S>(s.particles.initialVelocity[0]), toS<S>(s.particles.initialVelocity[1]),
+                             toS<S>(s.particles.initialVelocity[2]));
+  if (lodWindow_) {
+    // The window starts centred on lod.center (default: the field centre).
+    const Rational cx = s.lod.centerGiven ? s.lod.centerX : f.centerX, cz = s.lod.centerGiven ? s.lod.centerZ : f.centerZ;
+    startI = clampWindowOrigin(nearestParticleColumn(toS<S>(cx), lattice_.originX) - (grid_.countX - 1) / 2, true);
+    startJ = clampWindowOrigin(nearestParticleColumn(toS<S>(cz), lattice_.originZ) - (grid_.countZ - 1) / 2, false);
+  }
+  fillWindow(startI, startJ, true);
   dispX_.assign(size_t(grid_.size()), S(0));
   dispY_.assign(size_t(grid_.size()), S(0));
   dispZ_.assign(size_t(grid_.size()), S(0));
@@ -237,6 +238,103 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   setThreads(pool_->threads());
   takeFixedFaults();
   updatePatchState();
+}
+
+// ---- the level-of-detail window (sim/lod/lattice_window.h, docs/level-of-detail.md) ----------
+
+template <class S>
+int64_t World<S>::nearestParticleColumn(S coordinate, S fieldOrigin) const {
+  return floorToInt((coordinate - fieldOrigin) * bodyParticle_.invParticleSpacing + S(1) / S(2));
+}
+
+template <class S>
+int64_t World<S>::clampWindowOrigin(int64_t origin, bool alongX) const {
+  const LatticeWindow& w = grid_.window;
+  // The last origin keeps every held patch inside the field: k (origin + size - 1) <= patches - 1.
+  const int64_t last = alongX ? (patchWindow_.fieldI - 1) / grid_.k - (w.sizeI - 1)
+                              : (patchWindow_.fieldJ - 1) / grid_.k - (w.sizeJ - 1);
+  return std::clamp<int64_t>(origin, 0, std::max<int64_t>(0, last));
+}
+
+template <class S>
+void World<S>::initParticle(int64_t I, int64_t J, bool initialVelocity) {
+  const size_t q = grid_.window.storageIndex(I, J);
+  S x, z;
+  lattice_.rootXZ(I * grid_.k, J * grid_.k, &x, &z);
+  const S y = terrain_.heightAt(x, z);
+  particles_.anchorX[q] = x;
+  particles_.anchorY[q] = y;
+  particles_.anchorZ[q] = z;
+  particles_.px[q] = x;
+  particles_.py[q] = y + particleConsts_.rodLength;
+  particles_.pz[q] = z;
+  // Particles entering a moving window start at rest; the scenario's initial velocity is the
+  // thesis' start-up kick for the first window only.
+  const Vec3<S> v = initialVelocity ? initialVelocity_ : Vec3<S>::Zero();
+  particles_.vx[q] = v.x();
+  particles_.vy[q] = v.y();
+  particles_.vz[q] = v.z();
+}
+
+template <class S>
+void World<S>::initPatch(int64_t i, int64_t j) {
+  const size_t p = patchWindow_.storageIndex(i, j);
+  lattice_.rootXZ(i, j, &patches_.rootX[p], &patches_.rootZ[p]);
+  patches_.rootY[p] = terrain_.heightAt(patches_.rootX[p], patches_.rootZ[p]);
+  patches_.rotation[p] = lattice_.rotation(i, j);
+  patches_.variant[p] = lattice_.variant(i, j);
+  // Markings use the un-jittered lattice point: straight lines despite the jitter.
+  if (markings_.onLine(lattice_.originX + mulInt(lattice_.spacing, i), lattice_.originZ + mulInt(lattice_.spacing, j)))
+    patches_.variant[p] = uint8_t(lattice_.atlasVariants);
+  // Mown tufts stay mown: the cut lives in the persistent world data, not in the window.
+  patches_.cut[p] = cuts_.count({i, j}) ? 1 : 0;
+}
+
+template <class S>
+void World<S>::fillWindow(int64_t originI, int64_t originJ, bool initialVelocity) {
+  moveWindowTo(originI, originJ, initialVelocity, true);
+}
+
+template <class S>
+void World<S>::moveWindowTo(int64_t originI, int64_t originJ, bool initialVelocity, bool everything) {
+  const LatticeWindow oldParticles = grid_.window, oldPatches = patchWindow_;
+  grid_.window.originI = originI;
+  grid_.window.originJ = originJ;
+  patchWindow_.originI = originI * grid_.k;
+  patchWindow_.originJ = originJ * grid_.k;
+  // Only what enters is written: rows new to the window entirely, other rows only in the
+  // columns new to it. Each cell depends on its lattice coordinates alone, so the result is the
+  // same whatever the path and the thread count.
+  auto fill = [&](const LatticeWindow& now, const LatticeWindow& before, auto&& init) {
+    pool_->run(now.sizeJ, [&](int64_t r, int) { forEachEnteringCell(now, before, everything, r, init); });
+  };
+  fill(grid_.window, oldParticles, [&](int64_t I, int64_t J) { initParticle(I, J, initialVelocity); });
+  fill(patchWindow_, oldPatches, [&](int64_t i, int64_t j) { initPatch(i, j); });
+  if (lodWindow_)
+    edgeRing_.follow(patchWindow_, terrain_, markings_, [&](int64_t i, int64_t j) { return cuts_.count({i, j}) > 0; },
+                     everything);
+}
+
+template <class S>
+void World<S>::followCamera(const InputVec3& camera) {
+  // The window's centre follows the camera's nearest particle column and row with a dead zone of
+  // one particle spacing: a camera that stops, or wobbles across a cell border, moves nothing.
+  // (The thesis accumulated projected camera motion per side; this is a function of the camera
+  // position and the window alone, so it cannot drift.)
+  const auto toScalar = [](int64_t raw) {
+    return ScalarTraits<S>::fromRational(Rational{raw, int64_t(1) << 32}).value_or(S(0));
+  };
+  const int64_t camI = nearestParticleColumn(toScalar(camera.x), lattice_.originX);
+  const int64_t camJ = nearestParticleColumn(toScalar(camera.z), lattice_.originZ);
+  auto follow = [](int64_t origin, int64_t size, int64_t cam) {
+    const int64_t centre = origin + (size - 1) / 2;
+    if (cam > centre + 1) return origin + (cam - 1 - centre);
+    if (cam < centre - 1) return origin - (centre - 1 - cam);
+    return origin;
+  };
+  const int64_t I0 = clampWindowOrigin(follow(grid_.window.originI, grid_.window.sizeI, camI), true);
+  const int64_t J0 = clampWindowOrigin(follow(grid_.window.originJ, grid_.window.sizeJ, camJ), false);
+  if (I0 != grid_.window.originI || J0 != grid_.window.originJ) moveWindowTo(I0, J0, false, false);
 }
 
 template <class S>
@@ -248,8 +346,14 @@ void World<S>::setThreads(int threads) {
 
 template <class S>
 WorldCounts World<S>::counts() const {
-  return {lattice_.patchesX, lattice_.patchesZ, grid_.countX, grid_.countZ, grid_.k, pool_->threads(),
-          int64_t(bodies_.size()), int64_t(contacts_.size())};
+  WorldCounts n{lattice_.patchesX, lattice_.patchesZ, grid_.countX, grid_.countZ, grid_.k, pool_->threads(),
+                int64_t(bodies_.size()), int64_t(contacts_.size())};
+  n.lodWindow = lodWindow_;
+  n.windowPatchesX = patchWindow_.sizeI;
+  n.windowPatchesZ = patchWindow_.sizeJ;
+  n.windowOriginI = patchWindow_.originI;
+  n.windowOriginJ = patchWindow_.originJ;
+  return n;
 }
 
 // ---- the step -------------------------------------------------------------------------------
@@ -280,8 +384,8 @@ bool World<S>::runParticleRows(Stage stage, Fn&& rowKernel) {
     failure_.tick = tick_;
     failure_.stage = stage;
     failure_.particle = q;
-    failure_.latticeI = (q % grid_.countX) * grid_.k;
-    failure_.latticeJ = (q / grid_.countX) * grid_.k;
+    failure_.latticeI = grid_.window.latticeColumn(q % grid_.countX) * grid_.k;
+    failure_.latticeJ = grid_.window.latticeRow(q / grid_.countX) * grid_.k;
     failure_.what = faultBits[size_t(c)] ? fixedFaultName(faultBits[size_t(c)]) : "non-finite value";
     return false;
   }
@@ -295,13 +399,21 @@ void World<S>::updatePatchState() {
     const int64_t b1 = std::min(grid_.countZ, (c + 1) * rowsPerChunk_);
     particleDisplacement(particles_, c * rowsPerChunk_ * grid_.countX, b1 * grid_.countX, rod, dispX_, dispY_, dispZ_);
   });
-  const int64_t nx = lattice_.patchesX;
-  const int64_t patchRowsPerChunk = std::max<int64_t>(1, kTargetChunkElements / nx);
-  pool_->run((lattice_.patchesZ + patchRowsPerChunk - 1) / patchRowsPerChunk, [&](int64_t c, int worker) {
+  if (grid_.k == 1) {  // patch and particle windows coincide: storage index for storage index
+    pool_->run((grid_.countZ + rowsPerChunk_ - 1) / rowsPerChunk_, [&](int64_t c, int) {
+      const int64_t b1 = std::min(grid_.countZ, (c + 1) * rowsPerChunk_);
+      for (int64_t q = c * rowsPerChunk_ * grid_.countX; q < b1 * grid_.countX; ++q)
+        writePatch(patches_, size_t(q), dispX_[size_t(q)], dispY_[size_t(q)], dispZ_[size_t(q)], patchConsts_);
+    });
+    return;
+  }
+  const LatticeWindow& pw = patchWindow_;
+  const int64_t patchRowsPerChunk = std::max<int64_t>(1, kTargetChunkElements / pw.sizeI);
+  pool_->run((pw.sizeJ + patchRowsPerChunk - 1) / patchRowsPerChunk, [&](int64_t c, int worker) {
     S* scratch = rowScratch_.data() + size_t(worker) * size_t(3 * grid_.countX);
-    const int64_t j1 = std::min(lattice_.patchesZ, (c + 1) * patchRowsPerChunk);
-    for (int64_t j = c * patchRowsPerChunk; j < j1; ++j)
-      updatePatchRow(patches_, nx, j, grid_, dispX_, dispY_, dispZ_, patchConsts_, scratch);
+    const int64_t j1 = pw.originJ + std::min(pw.sizeJ, (c + 1) * patchRowsPerChunk);
+    for (int64_t j = pw.originJ + c * patchRowsPerChunk; j < j1; ++j)
+      updatePatchRow(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch);
   });
 }
 
@@ -384,11 +496,13 @@ void World<S>::mowGrass() {
       const int64_t i1 = std::min<int64_t>(lattice_.patchesX - 1, floorToInt((pose.position.x() + reach - lattice_.originX) * invSpacing) + 1);
       const int64_t j0 = std::max<int64_t>(0, floorToInt((pose.position.z() - reach - lattice_.originZ) * invSpacing));
       const int64_t j1 = std::min<int64_t>(lattice_.patchesZ - 1, floorToInt((pose.position.z() + reach - lattice_.originZ) * invSpacing) + 1);
+      // Roots come from the lattice, not the window: a mower cuts wherever it drives.
       for (int64_t j = j0; j <= j1; ++j)
         for (int64_t i = i0; i <= i1; ++i) {
-          const size_t p = size_t(j * lattice_.patchesX + i);
-          if (patches_.cut[p]) continue;
-          const Vec3<S> blade(patches_.rootX[p], patches_.rootY[p] + mowerCutHeight_, patches_.rootZ[p]);
+          if (cuts_.count({i, j})) continue;
+          S rootX, rootZ;
+          lattice_.rootXZ(i, j, &rootX, &rootZ);
+          const Vec3<S> blade(rootX, terrain_.heightAt(rootX, rootZ) + mowerCutHeight_, rootZ);
           bool inside;
           if (shape.type == ShapeType::Sphere) {
             const Vec3<S> d = blade - pose.position;
@@ -400,7 +514,7 @@ void World<S>::mowGrass() {
                      abs(local.z()) < shape.halfExtents.z();
           }
           if (!inside) continue;
-          patches_.cut[p] = 1;
+          if (patchWindow_.contains(i, j)) patches_.cut[patchWindow_.storageIndex(i, j)] = 1;
           cuts_.emplace(std::make_pair(i, j), uint8_t(1));
         }
     }
@@ -443,6 +557,11 @@ StepResult World<S>::step(const TickInput& input, StageObserver* observer) {
   auto end = [&](Stage st) { if (observer) observer->stageEnd(st); };
   const bool hasBodies = !bodies_.empty();
   takeFixedFaults();
+  if (lodWindow_) {
+    begin(Stage::Window);
+    if (input.hasCamera) followCamera(input.camera);
+    end(Stage::Window);
+  }
   if (hasBodies) {
     applyCommands(input);
     if (bodiesFaulted(Stage::Collision)) return {false, failure_};
@@ -477,7 +596,8 @@ StepResult World<S>::step(const TickInput& input, StageObserver* observer) {
   const bool pbd = constraintMode_ == ConstraintMode::Pbd;
   begin(Stage::Integrate);
   const bool integrated = runParticleRows(Stage::Integrate, [&](int64_t row, int64_t b, int64_t e) {
-    const S dvx = rowAccel_.x[size_t(row)], dvy = rowAccel_.y[size_t(row)], dvz = rowAccel_.z[size_t(row)];
+    const size_t windRow = size_t(grid_.window.latticeRow(row));  // the wind acts per lattice row
+    const S dvx = rowAccel_.x[windRow], dvy = rowAccel_.y[windRow], dvz = rowAccel_.z[windRow];
     return pbd ? integrateParticleRow<S, true>(particles_, b, e, dvx, dvy, dvz, c)
                : integrateParticleRow<S, false>(particles_, b, e, dvx, dvy, dvz, c);
   });
@@ -553,6 +673,12 @@ void World<S>::serialise(StateSink& sink) const {
   for (const auto& [key, value] : cuts_) {
     const int64_t ij[2] = {key.first, key.second};
     sink.write(ij, sizeof ij);
+  }
+  // The level-of-detail window's origin (only when it is on: other states are unchanged). The
+  // particle arrays above are in its toroidal storage order, a function of the origin alone.
+  if (lodWindow_) {
+    const int64_t origin[2] = {grid_.window.originI, grid_.window.originJ};
+    sink.write(origin, sizeof origin);
   }
 }
 
@@ -632,10 +758,17 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   std::memcpy(&edits, bytes.data() + editsAt, 8);
   if (edits > uint64_t(lattice_.patchesX * lattice_.patchesZ))
     throw StateError(editsAt, "at most one edit per patch, got " + std::to_string(edits));
-  const size_t totalSize = fixedSize + size_t(edits) * 16;
+  const size_t windowAt = fixedSize + size_t(edits) * 16;
+  const size_t totalSize = windowAt + (lodWindow_ ? 16 : 0);
   if (bytes.size() != totalSize)
     throw StateError(std::min(bytes.size(), totalSize), std::to_string(totalSize) + " bytes of state, got " +
                                                             std::to_string(bytes.size()));
+  int64_t windowOrigin[2] = {0, 0};
+  if (lodWindow_) {
+    std::memcpy(windowOrigin, bytes.data() + windowAt, 16);
+    if (windowOrigin[0] != clampWindowOrigin(windowOrigin[0], true) || windowOrigin[1] != clampWindowOrigin(windowOrigin[1], false))
+      throw StateError(windowAt, "a window origin that keeps the window inside the field");
+  }
   std::map<std::pair<int64_t, int64_t>, uint8_t> cuts;
   for (uint64_t e = 0; e < edits; ++e) {
     int64_t ij[2];
@@ -647,6 +780,10 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
       throw StateError(at, "patch edits in increasing (i, j) order");
     cuts.emplace(std::make_pair(ij[0], ij[1]), uint8_t(1));
   }
+  // Static window data first (anchors, patches, cut flags from the restored cuts), then the
+  // particles' dynamic state over it.
+  cuts_ = std::move(cuts);
+  if (lodWindow_) fillWindow(windowOrigin[0], windowOrigin[1], false);
   const uint8_t* src = bytes.data() + kStateHeaderBytes;
   for (auto* v : {&particles_.px, &particles_.py, &particles_.pz, &particles_.vx, &particles_.vy, &particles_.vz}) {
     std::memcpy(v->data(), src, n * sizeof(S));
@@ -667,10 +804,11 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
     b.asleep = sleep[1] != 0;
     b.updateDerived();
   }
-  cuts_ = std::move(cuts);
   impulseCache_ = std::move(cache);
-  std::fill(patches_.cut.begin(), patches_.cut.end(), uint8_t(0));
-  for (const auto& [key, value] : cuts_) patches_.cut[size_t(key.second * lattice_.patchesX + key.first)] = 1;
+  if (!lodWindow_) {
+    std::fill(patches_.cut.begin(), patches_.cut.end(), uint8_t(0));
+    for (const auto& [key, value] : cuts_) patches_.cut[patchWindow_.storageIndex(key.first, key.second)] = 1;
+  }
   tick_ = tick;
   failed_ = false;
   failure_ = SimError{};
@@ -686,11 +824,27 @@ void World<S>::observe(Observation& out) const {
   out.tipX.resize(n);
   out.tipY.resize(n);
   out.tipZ.resize(n);
-  for (size_t p = 0; p < n; ++p) {
-    out.tipX[p] = ScalarTraits<S>::toDouble(patches_.rootX[p] + patches_.tipOffsetX[p]);
-    out.tipY[p] = ScalarTraits<S>::toDouble(patches_.topY[p]);
-    out.tipZ[p] = ScalarTraits<S>::toDouble(patches_.rootZ[p] + patches_.tipOffsetZ[p]);
-  }
+  // The whole field: held patches as simulated, the others standing at rest (what the window
+  // leaves out is exactly what compare's lod variant measures).
+  const S zero(0);
+  for (int64_t j = 0; j < lattice_.patchesZ; ++j)
+    for (int64_t i = 0; i < lattice_.patchesX; ++i) {
+      const size_t o = size_t(j * lattice_.patchesX + i);
+      S x, y, z;
+      if (patchWindow_.contains(i, j)) {
+        const size_t p = patchWindow_.storageIndex(i, j);
+        x = patches_.rootX[p] + patches_.tipOffsetX[p];
+        y = patches_.topY[p];
+        z = patches_.rootZ[p] + patches_.tipOffsetZ[p];
+      } else {
+        lattice_.rootXZ(i, j, &x, &z);
+        const S top = patchConsts_.scaleY - (cuts_.count({i, j}) ? patchConsts_.cutReduction : zero);
+        y = terrain_.heightAt(x, z) + (top < patchConsts_.minimumTop ? patchConsts_.minimumTop : top);
+      }
+      out.tipX[o] = ScalarTraits<S>::toDouble(x);
+      out.tipY[o] = ScalarTraits<S>::toDouble(y);
+      out.tipZ[o] = ScalarTraits<S>::toDouble(z);
+    }
   out.bodyPosition.clear();
   out.bodyOrientation.clear();
   for (const RigidBody<S>& b : bodies_) {

@@ -21,6 +21,7 @@
 #include "sim/collision/contact_solver.h"
 #include "sim/field/grass_field.h"
 #include "sim/field/markings.h"
+#include "sim/lod/edge_ring.h"
 #include "sim/particles/particles.h"
 #include "sim/patches/patch_state.h"
 #include "sim/scenario/scenario.h"
@@ -58,13 +59,17 @@ class StateError : public std::runtime_error {
 };
 
 struct WorldCounts {
-  int64_t patchesX = 0, patchesZ = 0;
-  int64_t particlesX = 0, particlesZ = 0;
+  int64_t patchesX = 0, patchesZ = 0;      ///< the field
+  int64_t particlesX = 0, particlesZ = 0;  ///< simulated (the window's, with the level of detail on)
   int interpolation = 1;
   int threads = 1;
   int64_t bodies = 0;
   int64_t contacts = 0;  ///< body contacts found in the last tick
+  bool lodWindow = false;                 ///< the level-of-detail window is on
+  int64_t windowPatchesX = 0, windowPatchesZ = 0;  ///< simulated patches (the field when off)
+  int64_t windowOriginI = 0, windowOriginJ = 0;    ///< lattice patch of the window's first corner
   int64_t patches() const { return patchesX * patchesZ; }
+  int64_t simulatedPatches() const { return windowPatchesX * windowPatchesZ; }
   int64_t particles() const { return particlesX * particlesZ; }
 };
 
@@ -119,6 +124,11 @@ class World final : public SimWorld {
   const ParticleArrays<S>& particles() const { return particles_; }
   ParticleArrays<S>& mutableParticles() { return particles_; }  ///< tests: set up states
   const PatchArrays<S>& patches() const { return patches_; }
+  /// Which patches patches() holds; storageIndex(i, j) finds patch (i, j) (row-major j * patchesX
+  /// + i with the level of detail off).
+  const LatticeWindow& patchWindow() const { return patchWindow_; }
+  /// Level-of-detail level 1 (empty with the level of detail off).
+  const EdgeRing<S>& edgeRing() const { return edgeRing_; }
   const ParticleGrid& particleGrid() const { return grid_; }
   const GrassLattice<S>& lattice() const { return lattice_; }
   const Terrain<S>& terrain() const { return terrain_; }
@@ -141,11 +151,23 @@ class World final : public SimWorld {
   bool bodiesFaulted(Stage stage);
   void mowGrass();
   void serialise(class StateSink& sink) const;
+  // Level-of-detail window.
+  int64_t nearestParticleColumn(S coordinate, S fieldOrigin) const;
+  int64_t clampWindowOrigin(int64_t origin, bool alongX) const;
+  void initParticle(int64_t I, int64_t J, bool initialVelocity);
+  void initPatch(int64_t i, int64_t j);
+  void fillWindow(int64_t originI, int64_t originJ, bool initialVelocity);
+  void moveWindowTo(int64_t originI, int64_t originJ, bool initialVelocity, bool everything);
+  void followCamera(const InputVec3& camera);
 
   uint64_t configHash_ = 0;
   ConstraintMode constraintMode_ = ConstraintMode::Thesis;
   GrassLattice<S> lattice_;
   PatchArrays<S> patches_;
+  LatticeWindow patchWindow_;  ///< which patches patches_ holds (toroidal, like the particles)
+  bool lodWindow_ = false;     ///< the level-of-detail window is on (else the window is the field)
+  Vec3<S> initialVelocity_ = Vec3<S>::Zero();
+  EdgeRing<S> edgeRing_;       ///< level 1 around the window (rows = 0 with the level of detail off)
   ParticleGrid grid_;
   ParticleArrays<S> particles_;
   ParticleConstants<S> particleConsts_;
