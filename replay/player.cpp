@@ -42,8 +42,11 @@ Scenario recordedScenario(const sgr::Recording& rec, const VariantSettings& over
 Player::Player(const sgr::Recording& recording, int threads, const VariantSettings& variant)
     : recording_(recording), threads_(variant.threads.value_or(threads)) {
   scenario_ = recordedScenario(recording, variant);
-  const VariantSettings recorded = VariantSettings::parse(recording.header.variant);
+  // Settings compared once resolved (a recording's variant string may omit keys it left at the
+  // scenario's value, e.g. recordings made before `lod` existed).
+  const VariantSettings recorded = VariantSettings::resolvedFrom(recordedScenario(recording));
   sameSettings_ = variant.mustBeIdenticalTo(recorded);
+  exactSettings_ = VariantSettings::resolvedFrom(scenario_).describe() == recorded.describe();
   try {
     // The machine's memory is the budget (as for `simgrass record`): a recording whose scenario
     // asks for more is an error here, not a failed allocation later.
@@ -119,7 +122,7 @@ VerifyReport Player::verify(const std::function<void(int64_t)>& progress) {
   // Snapshots are what seeking restores, and their hash (checked above) says nothing about their
   // bytes: each must decompress (a damaged frame throws RecordingError) and, when this world runs
   // with exactly the recorded settings, hold the state replayed at its tick.
-  const bool exactSettings = VariantSettings::resolvedFrom(scenario_).describe() == recording_.header.variant;
+  const bool exactSettings = exactSettings_;
   size_t nextSnapshot = 0;
   while (world_->tick() < last) {
     StepResult r = stepForward();

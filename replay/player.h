@@ -56,6 +56,7 @@ class Player {
   Scenario scenario_;
   int threads_;
   bool sameSettings_ = true;
+  bool exactSettings_ = true;  ///< every setting as recorded (threads aside): snapshots compare byte for byte
   std::unique_ptr<SimWorld> world_;
 };
 

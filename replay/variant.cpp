@@ -93,7 +93,7 @@ VariantSettings VariantSettings::resolvedFrom(const Scenario& s) {
   v.broadphase = s.bodies.particleBroadphase;
   v.bodyBroadphase = s.bodies.bodyBroadphase;
   v.timeStep = s.timeStep;
-  if (s.lod.mode == LodMode::Window) v.lod = LodMode::Window;  // off is the default: not written
+  v.lod = s.lod.mode;
   return v;
 }
 

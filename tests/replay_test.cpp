@@ -243,10 +243,12 @@ TEST(Variant, ParsesDescribesAndOverrides) {
   EXPECT_EQ(v.describe(), "scalar=fx16 interp=2 broadphase=brute body-broadphase=sap dt=1/120 threads=3");
   EXPECT_EQ(VariantSettings::parse(v.describe()).describe(), v.describe());
   const VariantSettings base = VariantSettings::resolvedFrom(test::thesisMeadow());
-  EXPECT_EQ(base.describe(), "scalar=fx32 interp=1 broadphase=grid body-broadphase=brute dt=1/60");
+  EXPECT_EQ(base.describe(), "scalar=fx32 interp=1 broadphase=grid body-broadphase=brute dt=1/60 lod=off");
   EXPECT_TRUE(VariantSettings::parse("broadphase=brute threads=2").mustBeIdenticalTo(base));
   EXPECT_FALSE(VariantSettings::parse("interp=2").mustBeIdenticalTo(base));
   EXPECT_FALSE(VariantSettings::parse("dt=1/120").mustBeIdenticalTo(base));
+  EXPECT_FALSE(VariantSettings::parse("lod=window").mustBeIdenticalTo(base));
+  EXPECT_TRUE(VariantSettings::parse("lod=off").mustBeIdenticalTo(base));
   EXPECT_TRUE(VariantSettings::parse("scalar=fx32").mustBeIdenticalTo(base));
   for (const char* bad : {"interp=5", "scalar=q8", "dt=0", "dt=2", "threads=0", "lod=maybe", "speed=3", "interp"}) {
     EXPECT_THROW(VariantSettings::parse(bad), std::invalid_argument) << bad;
