@@ -62,7 +62,8 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Combine(::testing::Values(GoldenCase{"thesis-meadow", "fx32"}, GoldenCase{"thesis-meadow", "fx16"},
                                          GoldenCase{"hilly-meadow", "fx32"}, GoldenCase{"hilly-meadow", "fx16"},
                                          GoldenCase{"thesis-bodies", "fx32"}, GoldenCase{"thesis-bodies", "fx16"},
-                                         GoldenCase{"mower-field", "fx32"}, GoldenCase{"mower-field", "fx16"}),
+                                         GoldenCase{"mower-field", "fx32"}, GoldenCase{"mower-field", "fx16"},
+                                         GoldenCase{"lod-crossing", "fx32"}, GoldenCase{"lod-crossing", "fx16"}),
                        ::testing::Values(1, 2, 4)),
     [](const auto& info) {
       const GoldenCase& c = std::get<0>(info.param);
@@ -93,7 +94,8 @@ INSTANTIATE_TEST_SUITE_P(Goldens, SaveRestore,
                          ::testing::Values(GoldenCase{"thesis-meadow", "fx32"}, GoldenCase{"thesis-meadow", "fx16"},
                                            GoldenCase{"hilly-meadow", "fx32"}, GoldenCase{"hilly-meadow", "fx16"},
                                            GoldenCase{"thesis-bodies", "fx32"}, GoldenCase{"thesis-bodies", "fx16"},
-                                         GoldenCase{"mower-field", "fx32"}, GoldenCase{"mower-field", "fx16"}),
+                                         GoldenCase{"mower-field", "fx32"}, GoldenCase{"mower-field", "fx16"},
+                                         GoldenCase{"lod-crossing", "fx32"}, GoldenCase{"lod-crossing", "fx16"}),
                          [](const auto& info) {
                            std::string n = info.param.scenario + "_" + info.param.scalar;
                            for (char& ch : n) if (ch == '-') ch = '_';

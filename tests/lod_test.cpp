@@ -7,6 +7,7 @@
 #include <cstring>
 #include <set>
 
+#include "tests/cli_support.h"
 #include "tests/test_support.h"
 
 namespace sg {
@@ -268,6 +269,29 @@ TEST(LevelOfDetail, OffIsTheWholeFieldAndTheWindowCanBeAsLargeAsTheField) {
   }
   EXPECT_EQ(a->particles().px, b->particles().px);
   EXPECT_EQ(a->particles().vy, b->particles().vy);
+}
+
+TEST(LevelOfDetail, CompareReportsTheWindowsErrorAndSpeedUp) {
+  // The whole field recorded, replayed under lod=window: the grass the window leaves out is the
+  // error (nonzero), the window is the speed-up; lod=off must be bit-identical to the recording.
+  TempDir dir;
+  const std::string run = dir.file("off.sgr");
+  const int ticks = test::slowBuild() ? 6 : 40;
+  const CliResult rec = runCli("record --variant lod=off " + quote(test::sourcePath("scenarios/lod-crossing.json")) +
+                               " -o " + quote(run) + " --ticks " + std::to_string(ticks));
+  ASSERT_EQ(rec.exitCode, 0) << rec.describe();
+  const CliResult cmp = runCli("compare " + quote(run) + " --variant lod=window --variant lod=off,threads=2 --json");
+  ASSERT_EQ(cmp.exitCode, 0) << cmp.describe();
+  const json j = parseJson(cmp);
+  ASSERT_EQ(j["variants"].size(), 2u);
+  const json& window = j["variants"][0];
+  EXPECT_EQ(window["status"], "differs");
+  EXPECT_GT(window["tipMax"].get<double>(), 0.01);
+  EXPECT_EQ(window["firstDivergentTick"], 1);
+  EXPECT_EQ(window["bodyPositionMax"].get<double>(), 0.0) << "bodies do not feel the grass";
+  EXPECT_EQ(j["variants"][1]["status"], "identical");
+  if (!test::slowBuild())  // 14,641 simulated particles instead of 231,361: far faster
+    EXPECT_LT(window["msPerTick"].get<double>() * 3, j["reference"]["msPerTick"].get<double>()) << cmp.out;
 }
 
 }  // namespace

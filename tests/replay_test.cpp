@@ -89,7 +89,7 @@ TEST_P(RecordReplay, EveryCheckMatchesAndSeekEqualsTheUninterruptedRun) {
 
 const ScenarioCase kScenarios[] = {
     {"thesis-meadow.json", 60}, {"hilly-meadow.json", 60}, {"thesis-bodies.json", 90},
-    {"mower-field.json", 90},   {"million-meadow.json", 4},
+    {"mower-field.json", 90},   {"million-meadow.json", 4}, {"lod-crossing.json", 90},
 };
 INSTANTIATE_TEST_SUITE_P(Scenarios, RecordReplay,
                          testing::Combine(testing::ValuesIn(kScenarios),

@@ -8,6 +8,7 @@
 // order is plain row-major order: the level of detail off is the identity.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 
@@ -46,8 +47,14 @@ template <class Fn>
 void forEachEnteringCell(const LatticeWindow& now, const LatticeWindow& before, bool everything, int64_t r, Fn&& enter) {
   const int64_t j = now.originJ + r;
   const bool rowWasHeld = !everything && j >= before.originJ && j < before.endJ();
-  for (int64_t i = now.originI; i < now.endI(); ++i)
-    if (!rowWasHeld || i < before.originI || i >= before.endI()) enter(i, j);
+  if (!rowWasHeld) {
+    for (int64_t i = now.originI; i < now.endI(); ++i) enter(i, j);
+    return;
+  }
+  // A held row: only the columns left and right of what was held (no per-cell test, so a shift
+  // costs what enters, not what is held).
+  for (int64_t i = now.originI; i < std::min(now.endI(), before.originI); ++i) enter(i, j);
+  for (int64_t i = std::max(now.originI, before.endI()); i < now.endI(); ++i) enter(i, j);
 }
 
 }  // namespace sg
