@@ -63,8 +63,10 @@ int replay(const ReplayOptions& o) {
       std::printf("recording  %s (%s)\n", o.file.c_str(), rec->end ? "complete" : "cut off before END");
       std::printf("scenario   %s, %s\n", rec->header.scenarioSource.c_str(), rec->header.variant.c_str());
       std::printf("built by   %s\n", rec->header.buildId.c_str());
-      std::printf("ticks      %" PRId64 " to %" PRId64 "; %zu input chunks, %zu hashes, %zu snapshots\n",
-                  rec->header.startTick, rec->lastTick(), rec->inputs.size(), rec->checks.size(), rec->snapshots.size());
+      std::printf("ticks      %" PRId64 " to %" PRId64 "; %zu input chunk%s, %zu hash%s, %zu snapshot%s\n",
+                  rec->header.startTick, rec->lastTick(), rec->inputs.size(), rec->inputs.size() == 1 ? "" : "s",
+                  rec->checks.size(), rec->checks.size() == 1 ? "" : "es", rec->snapshots.size(),
+                  rec->snapshots.size() == 1 ? "" : "s");
     }
     return rec->truncated ? kExitTruncated : kExitOk;
   }
