@@ -6,6 +6,7 @@
 #include "replay/cli/compare_command.h"
 #include "replay/cli/diff_command.h"
 #include "replay/cli/record_command.h"
+#include "replay/cli/render_command.h"
 #include "replay/cli/replay_command.h"
 #include "replay/cli/run_command.h"
 
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
   sg::addReplayCommand(app, &exitCode);
   sg::addDiffCommand(app, &exitCode);
   sg::addCompareCommand(app, &exitCode);
+  sg::addRenderCommand(app, &exitCode);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

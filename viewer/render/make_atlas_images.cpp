@@ -1,0 +1,53 @@
+// simgrass-atlas: writes the procedural tuft atlas and ground texture as PNGs
+// (OUTDIR/tuft-atlas.png, OUTDIR/ground-texture.png), e.g. for docs/images.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <string>
+
+#include "viewer/render/atlas.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"Writes the procedural tuft atlas (tuft-atlas.png) and ground texture (ground-texture.png) into OUTDIR",
+               "simgrass-atlas"};
+  std::string outDir;
+  int variants = 4;
+  uint64_t seed = 1;
+  app.add_option("OUTDIR", outDir, "Existing directory to write the PNGs into")->required();
+  app.add_option("--variants", variants, "Grass tuft variants (atlas columns, plus the marking tuft)")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+  app.add_option("--seed", seed, "Seed of the procedural generation")->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "simgrass-atlas: %s (see 'simgrass-atlas --help')\n", e.what());
+    return 2;
+  }
+
+  const auto start = std::chrono::steady_clock::now();
+  const sg::viewer::TuftAtlas atlas = sg::viewer::makeTuftAtlas(variants, seed);
+  const auto atlasDone = std::chrono::steady_clock::now();
+  const sg::viewer::Image ground = sg::viewer::makeGroundTexture(atlas, seed);
+  const auto groundDone = std::chrono::steady_clock::now();
+  auto ms = [](auto a, auto b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
+
+  const struct {
+    std::string name;
+    const sg::viewer::Image* image;
+  } outputs[] = {{"tuft-atlas.png", &atlas.image}, {"ground-texture.png", &ground}};
+  for (const auto& out : outputs) {
+    const std::string path = outDir + "/" + out.name;
+    std::string error;
+    if (!sg::viewer::writePng(path, *out.image, &error)) {
+      std::fprintf(stderr, "simgrass-atlas: %s\n", error.c_str());
+      return 1;
+    }
+    std::printf("wrote %s (%d x %d)\n", path.c_str(), out.image->width, out.image->height);
+  }
+  std::printf("atlas %.1f ms, ground %.1f ms (variants %d, seed %llu)\n", ms(start, atlasDone),
+              ms(atlasDone, groundDone), variants, static_cast<unsigned long long>(seed));
+  return 0;
+}

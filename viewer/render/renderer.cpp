@@ -1,0 +1,507 @@
+#include "viewer/render/renderer.h"
+
+#include <GL/glew.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <vector>
+
+#include "viewer/render/shaders.h"
+
+namespace sg::viewer {
+namespace {
+
+constexpr int kMaxShadows = 16;
+constexpr int kMaxTiles = 68;  // (16 variants + marking tuft) * 4 levels
+
+/// A shader's or program's info log (getIv / getLog: the glGetShader* or glGetProgram* pair).
+template <class GetIv, class GetLog>
+std::string infoLog(GLuint object, GetIv getIv, GetLog getLog) {
+  GLint n = 0;
+  getIv(object, GL_INFO_LOG_LENGTH, &n);
+  std::string log(size_t(std::max(n, 1)), '\0');
+  getLog(object, n, nullptr, log.data());
+  return log.c_str();
+}
+
+GLuint compile(GLenum type, const std::string& source, const char* name) {
+  const GLuint s = glCreateShader(type);
+  const char* text = source.c_str();
+  glShaderSource(s, 1, &text, nullptr);
+  glCompileShader(s);
+  GLint ok = 0;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    const std::string log = infoLog(s, glGetShaderiv, glGetShaderInfoLog);
+    glDeleteShader(s);
+    throw std::runtime_error(std::string("renderer: shader '") + name + "' does not compile: " + log);
+  }
+  return s;
+}
+
+GLuint link(const std::string& vertex, const std::string& fragment, const char* name) {
+  const GLuint vs = compile(GL_VERTEX_SHADER, vertex, name);
+  GLuint fs = 0;
+  try {
+    fs = compile(GL_FRAGMENT_SHADER, fragment, name);
+  } catch (...) {
+    glDeleteShader(vs);
+    throw;
+  }
+  const GLuint p = glCreateProgram();
+  glAttachShader(p, vs);
+  glAttachShader(p, fs);
+  glLinkProgram(p);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = 0;
+  glGetProgramiv(p, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    const std::string log = infoLog(p, glGetProgramiv, glGetProgramInfoLog);
+    glDeleteProgram(p);
+    throw std::runtime_error(std::string("renderer: program '") + name + "' does not link: " + log);
+  }
+  return p;
+}
+
+std::string litFragment(const char* body) {
+  return std::string("#version 330 core\n") + shaders::kLightingFunctions + body;
+}
+
+GLint loc(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
+void set3(GLuint p, const char* name, const std::array<float, 3>& v) { glUniform3f(loc(p, name), v[0], v[1], v[2]); }
+void set3(GLuint p, const char* name, float x, float y, float z) { glUniform3f(loc(p, name), x, y, z); }
+void setMat(GLuint p, const char* name, const Mat4& m) { glUniformMatrix4fv(loc(p, name), 1, GL_FALSE, m.data()); }
+
+/// Inverse of a general 4x4 (column-major; cofactor expansion).
+Mat4 inverse4(const Mat4& m) {
+  Mat4 inv{};
+  inv[0] = m[5] * m[10] * m[15] - m[5] * m[11] * m[14] - m[9] * m[6] * m[15] + m[9] * m[7] * m[14] + m[13] * m[6] * m[11] - m[13] * m[7] * m[10];
+  inv[4] = -m[4] * m[10] * m[15] + m[4] * m[11] * m[14] + m[8] * m[6] * m[15] - m[8] * m[7] * m[14] - m[12] * m[6] * m[11] + m[12] * m[7] * m[10];
+  inv[8] = m[4] * m[9] * m[15] - m[4] * m[11] * m[13] - m[8] * m[5] * m[15] + m[8] * m[7] * m[13] + m[12] * m[5] * m[11] - m[12] * m[7] * m[9];
+  inv[12] = -m[4] * m[9] * m[14] + m[4] * m[10] * m[13] + m[8] * m[5] * m[14] - m[8] * m[6] * m[13] - m[12] * m[5] * m[10] + m[12] * m[6] * m[9];
+  inv[1] = -m[1] * m[10] * m[15] + m[1] * m[11] * m[14] + m[9] * m[2] * m[15] - m[9] * m[3] * m[14] - m[13] * m[2] * m[11] + m[13] * m[3] * m[10];
+  inv[5] = m[0] * m[10] * m[15] - m[0] * m[11] * m[14] - m[8] * m[2] * m[15] + m[8] * m[3] * m[14] + m[12] * m[2] * m[11] - m[12] * m[3] * m[10];
+  inv[9] = -m[0] * m[9] * m[15] + m[0] * m[11] * m[13] + m[8] * m[1] * m[15] - m[8] * m[3] * m[13] - m[12] * m[1] * m[11] + m[12] * m[3] * m[9];
+  inv[13] = m[0] * m[9] * m[14] - m[0] * m[10] * m[13] - m[8] * m[1] * m[14] + m[8] * m[2] * m[13] + m[12] * m[1] * m[10] - m[12] * m[2] * m[9];
+  inv[2] = m[1] * m[6] * m[15] - m[1] * m[7] * m[14] - m[5] * m[2] * m[15] + m[5] * m[3] * m[14] + m[13] * m[2] * m[7] - m[13] * m[3] * m[6];
+  inv[6] = -m[0] * m[6] * m[15] + m[0] * m[7] * m[14] + m[4] * m[2] * m[15] - m[4] * m[3] * m[14] - m[12] * m[2] * m[7] + m[12] * m[3] * m[6];
+  inv[10] = m[0] * m[5] * m[15] - m[0] * m[7] * m[13] - m[4] * m[1] * m[15] + m[4] * m[3] * m[13] + m[12] * m[1] * m[7] - m[12] * m[3] * m[5];
+  inv[14] = -m[0] * m[5] * m[14] + m[0] * m[6] * m[13] + m[4] * m[1] * m[14] - m[4] * m[2] * m[13] - m[12] * m[1] * m[6] + m[12] * m[2] * m[5];
+  inv[3] = -m[1] * m[6] * m[11] + m[1] * m[7] * m[10] + m[5] * m[2] * m[11] - m[5] * m[3] * m[10] - m[9] * m[2] * m[7] + m[9] * m[3] * m[6];
+  inv[7] = m[0] * m[6] * m[11] - m[0] * m[7] * m[10] - m[4] * m[2] * m[11] + m[4] * m[3] * m[10] + m[8] * m[2] * m[7] - m[8] * m[3] * m[6];
+  inv[11] = -m[0] * m[5] * m[11] + m[0] * m[7] * m[9] + m[4] * m[1] * m[11] - m[4] * m[3] * m[9] - m[8] * m[1] * m[7] + m[8] * m[3] * m[5];
+  inv[15] = m[0] * m[5] * m[10] - m[0] * m[6] * m[9] - m[4] * m[1] * m[10] + m[4] * m[2] * m[9] + m[8] * m[1] * m[6] - m[8] * m[2] * m[5];
+  float det = m[0] * inv[0] + m[1] * inv[4] + m[2] * inv[8] + m[3] * inv[12];
+  if (det == 0) return identity4();
+  det = 1.0f / det;
+  for (float& v : inv) v *= det;
+  return inv;
+}
+
+/// An indexed triangle mesh of position + normal (6 floats per vertex).
+struct Mesh {
+  GLuint vao = 0, vbo = 0, ebo = 0;
+  GLsizei indices = 0;
+
+  void upload(const std::vector<float>& vertices, const std::vector<uint32_t>& index) {
+    if (!vao) {
+      glGenVertexArrays(1, &vao);
+      glGenBuffers(1, &vbo);
+      glGenBuffers(1, &ebo);
+    }
+    glBindVertexArray(vao);
+    glBindBuffer(GL_ARRAY_BUFFER, vbo);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(float)), vertices.data(), GL_STATIC_DRAW);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ebo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(index.size() * sizeof(uint32_t)), index.data(), GL_STATIC_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), reinterpret_cast<const void*>(3 * sizeof(float)));
+    glBindVertexArray(0);
+    indices = GLsizei(index.size());
+  }
+  void draw() const {
+    glBindVertexArray(vao);
+    glDrawElements(GL_TRIANGLES, indices, GL_UNSIGNED_INT, nullptr);
+  }
+  void release() {
+    if (ebo) glDeleteBuffers(1, &ebo);
+    if (vbo) glDeleteBuffers(1, &vbo);
+    if (vao) glDeleteVertexArrays(1, &vao);
+    vao = vbo = ebo = 0;
+  }
+};
+
+void sphereMesh(Mesh* mesh) {
+  constexpr int kSlices = 32, kStacks = 16;
+  const float pi = 3.14159265358979f;
+  std::vector<float> v;
+  std::vector<uint32_t> idx;
+  for (int s = 0; s <= kStacks; ++s) {
+    const float phi = pi * float(s) / kStacks;  // from +y down
+    for (int a = 0; a <= kSlices; ++a) {
+      const float theta = 2 * pi * float(a) / kSlices;
+      const float x = std::sin(phi) * std::cos(theta), y = std::cos(phi), z = std::sin(phi) * std::sin(theta);
+      v.insert(v.end(), {x, y, z, x, y, z});
+    }
+  }
+  for (int s = 0; s < kStacks; ++s)
+    for (int a = 0; a < kSlices; ++a) {
+      const uint32_t i0 = uint32_t(s * (kSlices + 1) + a), i1 = i0 + 1, i2 = i0 + kSlices + 1, i3 = i2 + 1;
+      idx.insert(idx.end(), {i0, i2, i1, i1, i2, i3});
+    }
+  mesh->upload(v, idx);
+}
+
+void cubeMesh(Mesh* mesh) {
+  std::vector<float> v;
+  std::vector<uint32_t> idx;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int sign = -1; sign <= 1; sign += 2) {
+      const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+      const uint32_t base = uint32_t(v.size() / 6);
+      for (int c = 0; c < 4; ++c) {
+        float p[3], n[3] = {0, 0, 0};
+        p[axis] = float(sign);
+        p[u] = (c & 1) ? 1.0f : -1.0f;
+        p[w] = (c & 2) ? 1.0f : -1.0f;
+        n[axis] = float(sign);
+        v.insert(v.end(), {p[0], p[1], p[2], n[0], n[1], n[2]});
+      }
+      idx.insert(idx.end(), {base, base + 1, base + 2, base + 1, base + 3, base + 2});
+    }
+  mesh->upload(v, idx);
+}
+
+GLuint uploadTexture(const Image& image, bool repeat) {
+  GLuint t = 0;
+  glGenTextures(1, &t);
+  glBindTexture(GL_TEXTURE_2D, t);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  // Row 0 (the image's top) goes to t = 0, so the atlas' v coordinates (v0 at the top) apply as is.
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, image.width, image.height, 0, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  const GLint wrap = repeat ? GL_REPEAT : GL_CLAMP_TO_EDGE;
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap);
+  return t;
+}
+
+}  // namespace
+
+// ---- RenderTarget ----------------------------------------------------------------------------
+
+RenderTarget::RenderTarget(int width, int height, int samples) : width_(width), height_(height), samples_(samples) {
+  glGenFramebuffers(1, &drawFbo_);
+  glBindFramebuffer(GL_FRAMEBUFFER, drawFbo_);
+  glGenRenderbuffers(1, &colour_);
+  glBindRenderbuffer(GL_RENDERBUFFER, colour_);
+  if (samples > 0)
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, width, height);
+  else
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour_);
+  glGenRenderbuffers(1, &depth_);
+  glBindRenderbuffer(GL_RENDERBUFFER, depth_);
+  if (samples > 0)
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT24, width, height);
+  else
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_);
+  bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+  if (samples > 0 && complete) {
+    glGenFramebuffers(1, &resolveFbo_);
+    glBindFramebuffer(GL_FRAMEBUFFER, resolveFbo_);
+    glGenRenderbuffers(1, &resolveColour_);
+    glBindRenderbuffer(GL_RENDERBUFFER, resolveColour_);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, resolveColour_);
+    complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+  }
+  glBindRenderbuffer(GL_RENDERBUFFER, 0);
+  if (!complete) {
+    release();
+    throw std::runtime_error("renderer: the " + std::to_string(width) + "x" + std::to_string(height) + " framebuffer (" +
+                             std::to_string(samples) + " samples) is incomplete");
+  }
+  bind();
+}
+
+RenderTarget::~RenderTarget() { release(); }
+
+void RenderTarget::release() {
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  for (GLuint* f : {&drawFbo_, &resolveFbo_})
+    if (*f) glDeleteFramebuffers(1, f), *f = 0;
+  for (GLuint* r : {&colour_, &depth_, &resolveColour_})
+    if (*r) glDeleteRenderbuffers(1, r), *r = 0;
+}
+
+void RenderTarget::bind() {
+  glBindFramebuffer(GL_FRAMEBUFFER, drawFbo_);
+  glViewport(0, 0, width_, height_);
+}
+
+Image RenderTarget::read() {
+  if (samples_ > 0) {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, drawFbo_);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolveFbo_);
+    glBlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, resolveFbo_);
+  } else {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, drawFbo_);
+  }
+  Image raw;
+  raw.width = width_;
+  raw.height = height_;
+  raw.rgba.resize(size_t(width_) * size_t(height_) * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, raw.rgba.data());
+  // GL's row 0 is the bottom; PNG's is the top.
+  Image out = raw;
+  const size_t row = size_t(width_) * 4;
+  for (int y = 0; y < height_; ++y)
+    std::memcpy(out.rgba.data() + size_t(y) * row, raw.rgba.data() + size_t(height_ - 1 - y) * row, row);
+  for (size_t i = 3; i < out.rgba.size(); i += 4) out.rgba[i] = 255;
+  bind();
+  return out;
+}
+
+// ---- Renderer --------------------------------------------------------------------------------
+
+struct Renderer::Impl {
+  GLuint tuftProgram = 0, groundProgram = 0, bodyProgram = 0, skyProgram = 0;
+  GLuint tuftVao = 0, tuftBuffer = 0, emptyVao = 0;
+  size_t tuftCapacity = 0;
+  Mesh sphere, cube, ground;
+  uint64_t groundRevision = 0;
+  GLuint atlasTexture = 0, groundTexture = 0;
+  std::unique_ptr<TuftAtlas> atlas;
+  std::vector<TuftInstance> sorted;         ///< tufts front to back (scratch)
+  std::vector<std::pair<float, uint32_t>> order;
+  int atlasVariants = -1;
+  uint64_t atlasSeed = 0;
+
+  void ensureAtlas(int variants, uint64_t seed) {
+    if (atlas && variants == atlasVariants && seed == atlasSeed) return;
+    if (atlasTexture) glDeleteTextures(1, &atlasTexture);
+    if (groundTexture) glDeleteTextures(1, &groundTexture);
+    atlas = std::make_unique<TuftAtlas>(makeTuftAtlas(variants, seed));
+    atlasTexture = uploadTexture(atlas->image, false);
+    groundTexture = uploadTexture(makeGroundTexture(*atlas, seed), true);
+    atlasVariants = variants;
+    atlasSeed = seed;
+  }
+
+  void uploadGround(const GroundGrid& g) {
+    const size_t nx = g.xs.size(), nz = g.zs.size();
+    std::vector<float> v;
+    std::vector<uint32_t> idx;
+    if (nx >= 2 && nz >= 2 && g.heights.size() == nx * nz) {
+      v.reserve(nx * nz * 6);
+      auto h = [&](size_t i, size_t j) { return g.heights[j * nx + i]; };
+      for (size_t j = 0; j < nz; ++j)
+        for (size_t i = 0; i < nx; ++i) {
+          // Normal from central differences: (-dh/dx, 1, -dh/dz).
+          const size_t i0 = i > 0 ? i - 1 : i, i1 = i + 1 < nx ? i + 1 : i;
+          const size_t j0 = j > 0 ? j - 1 : j, j1 = j + 1 < nz ? j + 1 : j;
+          const float dhdx = (h(i1, j) - h(i0, j)) / std::max(1e-6f, g.xs[i1] - g.xs[i0]);
+          const float dhdz = (h(i, j1) - h(i, j0)) / std::max(1e-6f, g.zs[j1] - g.zs[j0]);
+          const float nl = std::sqrt(dhdx * dhdx + 1 + dhdz * dhdz);
+          v.insert(v.end(), {g.xs[i], h(i, j), g.zs[j], -dhdx / nl, 1 / nl, -dhdz / nl});
+        }
+      for (size_t j = 0; j + 1 < nz; ++j)
+        for (size_t i = 0; i + 1 < nx; ++i) {
+          const uint32_t a = uint32_t(j * nx + i), b = a + 1, c = uint32_t(a + nx), d = c + 1;
+          idx.insert(idx.end(), {a, c, b, b, c, d});
+        }
+    }
+    ground.upload(v, idx);
+    groundRevision = g.revision;
+  }
+
+  ~Impl() {
+    for (GLuint p : {tuftProgram, groundProgram, bodyProgram, skyProgram})
+      if (p) glDeleteProgram(p);
+    if (tuftBuffer) glDeleteBuffers(1, &tuftBuffer);
+    for (GLuint* a : {&tuftVao, &emptyVao})
+      if (*a) glDeleteVertexArrays(1, a);
+    sphere.release();
+    cube.release();
+    ground.release();
+    for (GLuint* t : {&atlasTexture, &groundTexture})
+      if (*t) glDeleteTextures(1, t);
+  }
+};
+
+Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
+  Impl& r = *impl_;
+  r.tuftProgram = link(shaders::kTuftVertex, litFragment(shaders::kTuftFragment), "tuft");
+  r.groundProgram = link(shaders::kGroundVertex, litFragment(shaders::kGroundFragment), "ground");
+  r.bodyProgram = link(shaders::kBodyVertex, litFragment(shaders::kBodyFragment), "body");
+  r.skyProgram = link(shaders::kSkyVertex, shaders::kSkyFragment, "sky");
+  glGenVertexArrays(1, &r.emptyVao);
+  glGenVertexArrays(1, &r.tuftVao);
+  glGenBuffers(1, &r.tuftBuffer);
+  glBindVertexArray(r.tuftVao);
+  glBindBuffer(GL_ARRAY_BUFFER, r.tuftBuffer);
+  static_assert(sizeof(TuftInstance) == 36, "TuftInstance is uploaded as is");
+  const GLsizei stride = sizeof(TuftInstance);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<const void*>(offsetof(TuftInstance, x)));
+  glVertexAttribDivisor(0, 1);
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<const void*>(offsetof(TuftInstance, topY)));
+  glVertexAttribDivisor(1, 1);
+  glEnableVertexAttribArray(2);
+  glVertexAttribPointer(2, 2, GL_UNSIGNED_BYTE, GL_FALSE, stride,
+                        reinterpret_cast<const void*>(offsetof(TuftInstance, variant)));
+  glVertexAttribDivisor(2, 1);
+  glBindVertexArray(0);
+  sphereMesh(&r.sphere);
+  cubeMesh(&r.cube);
+}
+
+Renderer::~Renderer() = default;
+
+const TuftAtlas* Renderer::atlas() const { return impl_->atlas.get(); }
+
+void Renderer::draw(const Scene& scene, const Camera& camera, int width, int height, bool alphaToCoverage) {
+  Impl& r = *impl_;
+  const Lighting& L = lighting_;
+  r.ensureAtlas(std::clamp(scene.atlasVariants, 1, 16), scene.atlasSeed);
+  if (r.groundRevision != scene.ground.revision) r.uploadGround(scene.ground);
+
+  const float aspect = float(width) / float(std::max(height, 1));
+  const Mat4 viewProj = multiply(camera.projection(aspect), camera.view());
+  std::array<float, 3> sun = L.sunDirection;
+  const float sl = std::sqrt(sun[0] * sun[0] + sun[1] * sun[1] + sun[2] * sun[2]);
+  for (float& c : sun) c /= sl;
+
+  glViewport(0, 0, width, height);
+  glClearColor(L.horizon[0], L.horizon[1], L.horizon[2], 1);
+  glClearDepth(1.0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+
+  // 1. Sky, behind everything (no depth test, no depth writes).
+  glDisable(GL_DEPTH_TEST);
+  glDepthMask(GL_FALSE);
+  glUseProgram(r.skyProgram);
+  setMat(r.skyProgram, "uInvViewProj", inverse4(viewProj));
+  set3(r.skyProgram, "uCameraPos", camera.x, camera.y, camera.z);
+  set3(r.skyProgram, "uSunDir", sun);
+  set3(r.skyProgram, "uZenith", L.zenith);
+  set3(r.skyProgram, "uHorizon", L.horizon);
+  glBindVertexArray(r.emptyVao);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_LESS);
+
+  // Body shadow discs (shared by the ground and the tufts).
+  std::vector<float> shadows;
+  for (const BodyPartDraw& b : scene.bodyParts) {
+    if (shadows.size() / 4 >= size_t(kMaxShadows)) break;
+    const Mat4& m = b.model;
+    const float ex = std::fabs(m[0]) + std::fabs(m[4]) + std::fabs(m[8]);
+    const float ey = std::fabs(m[1]) + std::fabs(m[5]) + std::fabs(m[9]);
+    const float ez = std::fabs(m[2]) + std::fabs(m[6]) + std::fabs(m[10]);
+    const float radius = b.shape == BodyPartDraw::Shape::Sphere ? ey : 0.5f * (ex + ez);
+    shadows.insert(shadows.end(), {m[12], m[14], radius, m[13] - ey});
+  }
+  auto common = [&](GLuint p) {
+    glUseProgram(p);
+    setMat(p, "uViewProj", viewProj);
+    set3(p, "uCameraPos", camera.x, camera.y, camera.z);
+    set3(p, "uSunDir", sun);
+    set3(p, "uSunColour", L.sunColour);
+    set3(p, "uAmbient", L.ambient);
+    set3(p, "uFogColour", L.horizon);
+    glUniform1f(loc(p, "uFogDensity"), L.fogDensity);
+    glUniform1i(loc(p, "uShadowCount"), GLint(shadows.size() / 4));
+    if (!shadows.empty()) glUniform4fv(loc(p, "uShadows"), GLsizei(shadows.size() / 4), shadows.data());
+  };
+
+  // 2. Ground.
+  if (r.ground.indices > 0) {
+    common(r.groundProgram);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, r.groundTexture);
+    glUniform1i(loc(r.groundProgram, "uGround"), 0);
+    glUniform1f(loc(r.groundProgram, "uGroundTile"), L.groundTileMetres);
+    glUniform1f(loc(r.groundProgram, "uGroundShade"), L.groundShade);
+    r.ground.draw();
+  }
+
+  // 3. Bodies.
+  if (!scene.bodyParts.empty()) {
+    common(r.bodyProgram);
+    for (const BodyPartDraw& b : scene.bodyParts) {
+      setMat(r.bodyProgram, "uModel", b.model);
+      set3(r.bodyProgram, "uAlbedo", b.colour[0], b.colour[1], b.colour[2]);
+      glUniform1i(loc(r.bodyProgram, "uFootball"), b.pattern == BodyPartDraw::Pattern::Football ? 1 : 0);
+      (b.shape == BodyPartDraw::Shape::Sphere ? r.sphere : r.cube).draw();
+    }
+  }
+
+  // 4. Tufts.
+  if (!scene.tufts.empty()) {
+    common(r.tuftProgram);
+    std::vector<float> tiles;
+    const TuftAtlas& atlas = *r.atlas;
+    for (int v = 0; v <= atlas.variants; ++v)
+      for (int l = 0; l < atlas.levels; ++l) {
+        const TuftAtlas::Rect t = atlas.tile(v, l);
+        tiles.insert(tiles.end(), {t.u0, t.v0, t.u1, t.v1});
+      }
+    glUniform4fv(loc(r.tuftProgram, "uTiles"), GLsizei(std::min<size_t>(tiles.size() / 4, kMaxTiles)), tiles.data());
+    glUniform1i(loc(r.tuftProgram, "uLevels"), atlas.levels);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, r.atlasTexture);
+    glUniform1i(loc(r.tuftProgram, "uAtlas"), 0);
+    glUniform2f(loc(r.tuftProgram, "uAtlasSize"), float(atlas.image.width), float(atlas.image.height));
+    glUniform1i(loc(r.tuftProgram, "uAlphaToCoverage"), alphaToCoverage ? 1 : 0);
+    // Front to back: the depth test then rejects most hidden tuft fragments before shading
+    // (a software rasteriser pays for every shaded fragment).
+    const size_t n = scene.tufts.size();
+    r.order.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      const TuftInstance& t = scene.tufts[i];
+      const float dx = t.x - camera.x, dz = t.z - camera.z;
+      r.order[i] = {dx * dx + dz * dz, uint32_t(i)};
+    }
+    std::sort(r.order.begin(), r.order.end());
+    r.sorted.resize(n);
+    for (size_t i = 0; i < n; ++i) r.sorted[i] = scene.tufts[r.order[i].second];
+    glBindVertexArray(r.tuftVao);
+    glBindBuffer(GL_ARRAY_BUFFER, r.tuftBuffer);
+    const size_t bytes = n * sizeof(TuftInstance);
+    if (n > r.tuftCapacity) {
+      glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(bytes), r.sorted.data(), GL_STREAM_DRAW);
+      r.tuftCapacity = n;
+    } else {
+      glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(bytes), r.sorted.data());
+    }
+    if (alphaToCoverage) glEnable(GL_SAMPLE_ALPHA_TO_COVERAGE);
+    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(scene.tufts.size()));
+    if (alphaToCoverage) glDisable(GL_SAMPLE_ALPHA_TO_COVERAGE);
+  }
+  glBindVertexArray(0);
+  glUseProgram(0);
+}
+
+std::string glDescription() {
+  const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const auto* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+  return std::string(renderer ? renderer : "?") + ", " + (version ? version : "?");
+}
+
+}  // namespace sg::viewer
