@@ -1,0 +1,108 @@
+#include "viewer/app/script.h"
+
+#include <GLFW/glfw3.h>
+
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+namespace sg::viewer {
+
+int scriptKeyCode(const std::string& name) {
+  std::string n;
+  for (char c : name) n += char(std::tolower(static_cast<unsigned char>(c)));
+  if (n.size() == 1 && n[0] >= 'a' && n[0] <= 'z') return GLFW_KEY_A + (n[0] - 'a');
+  if (n.size() == 1 && n[0] >= '0' && n[0] <= '9') return GLFW_KEY_0 + (n[0] - '0');
+  if (n == "tab") return GLFW_KEY_TAB;
+  if (n == "space") return GLFW_KEY_SPACE;
+  if (n == "shift") return GLFW_KEY_LEFT_SHIFT;
+  if (n == "ctrl") return GLFW_KEY_LEFT_CONTROL;
+  if (n == "escape") return GLFW_KEY_ESCAPE;
+  return -1;
+}
+
+namespace {
+bool parseCount(const std::string& s, int64_t max, int64_t* v) {
+  if (s.empty() || s.size() > 12) return false;
+  for (char c : s)
+    if (c < '0' || c > '9') return false;
+  *v = std::stoll(s);
+  return *v <= max;
+}
+
+bool parseFloat(const std::string& s, float* v) {
+  char* end = nullptr;
+  const double d = std::strtod(s.c_str(), &end);
+  if (s.empty() || end != s.c_str() + s.size() || !std::isfinite(d) || std::fabs(d) > 1e6) return false;
+  *v = float(d);
+  return true;
+}
+}  // namespace
+
+bool parseScript(const std::string& text, const std::string& file, std::vector<ScriptCommand>* out, std::string* error) {
+  std::istringstream in(text);
+  std::string raw;
+  int lineNo = 0;
+  auto fail = [&](const std::string& what) {
+    *error = file + ":" + std::to_string(lineNo) + ": " + what;
+    return false;
+  };
+  while (std::getline(in, raw)) {
+    ++lineNo;
+    if (!raw.empty() && raw.back() == '\r') raw.pop_back();
+    std::istringstream words(raw);
+    std::vector<std::string> w;
+    for (std::string s; words >> s;) w.push_back(s);
+    if (w.empty() || w[0][0] == '#') continue;
+    ScriptCommand c;
+    c.line = lineNo;
+    const std::string& cmd = w[0];
+    // The line, quoted for messages (control characters dropped: the message stays one line).
+    std::string shown;
+    for (char ch : raw)
+      if (static_cast<unsigned char>(ch) >= 0x20) shown += ch;
+    if (shown.size() > 80) shown = shown.substr(0, 80) + "...";
+    if (cmd == "frames") {
+      c.kind = ScriptCommand::Kind::Frames;
+      if (w.size() != 2 || !parseCount(w[1], 100000000, &c.count))
+        return fail("expected 'frames N' (N from 0 to 100000000), got '" + shown + "'");
+    } else if (cmd == "key") {
+      c.kind = ScriptCommand::Kind::Key;
+      if (w.size() != 3 || (w[2] != "down" && w[2] != "up") || (c.key = scriptKeyCode(w[1])) < 0)
+        return fail("expected 'key K down|up' (K: a letter, a digit, tab, space, shift, ctrl or escape), got '" +
+                    shown + "'");
+      c.down = w[2] == "down";
+    } else if (cmd == "camera") {
+      c.kind = ScriptCommand::Kind::Camera;
+      bool ok = w.size() == 6;
+      for (size_t i = 0; ok && i < 5; ++i) ok = parseFloat(w[i + 1], &c.camera[i]);
+      if (!ok || std::fabs(c.camera[4]) > 89)
+        return fail("expected 'camera x y z yaw pitch' (m, degrees; |pitch| <= 89), got '" + shown + "'");
+    } else if (cmd == "select") {
+      c.kind = ScriptCommand::Kind::Select;
+      if (w.size() != 2 || !parseCount(w[1], 1000000, &c.count)) return fail("expected 'select N', got '" + shown + "'");
+    } else if (cmd == "record" && w.size() == 3 && w[1] == "start") {
+      c.kind = ScriptCommand::Kind::RecordStart;
+      c.path = w[2];
+    } else if (cmd == "record" && w.size() == 2 && w[1] == "stop") {
+      c.kind = ScriptCommand::Kind::RecordStop;
+    } else if (cmd == "record") {
+      return fail("expected 'record start PATH' or 'record stop', got '" + shown + "'");
+    } else if (cmd == "screenshot") {
+      c.kind = ScriptCommand::Kind::Screenshot;
+      if (w.size() != 2) return fail("expected 'screenshot PATH', got '" + shown + "'");
+      c.path = w[1];
+    } else if (cmd == "quit") {
+      c.kind = ScriptCommand::Kind::Quit;
+      if (w.size() != 1) return fail("expected 'quit', got '" + shown + "'");
+    } else {
+      return fail("unknown command '" + shown +
+                  "' (expected frames, key, camera, select, record, screenshot or quit)");
+    }
+    out->push_back(c);
+  }
+  return true;
+}
+
+}  // namespace sg::viewer

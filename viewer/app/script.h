@@ -1,0 +1,30 @@
+// The viewer's test script (`simgrass-viewer --script FILE`, docs/viewer.md): one command a line,
+// parsed up front so a bad line fails before any window opens. With a script the run is
+// frame-locked: exactly one simulation tick per rendered frame.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace sg::viewer {
+
+struct ScriptCommand {
+  enum class Kind { Frames, Key, Camera, Select, RecordStart, RecordStop, Screenshot, Quit } kind = Kind::Quit;
+  int64_t count = 0;      ///< frames N; select N
+  int key = 0;            ///< GLFW key code (key K down|up)
+  bool down = false;
+  float camera[5] = {0, 0, 0, 0, 0};  ///< x y z yaw pitch
+  std::string path;       ///< record start PATH; screenshot PATH
+  int line = 0;           ///< 1-based line in the script file
+};
+
+/// GLFW key code of a script key name: a letter or digit (case-insensitive), or tab, space,
+/// shift, ctrl, escape. -1 when unknown.
+int scriptKeyCode(const std::string& name);
+
+/// Parses script text. Blank lines and lines starting with '#' are skipped. On an error returns
+/// false with *error = "FILE:LINE: what" (one line).
+bool parseScript(const std::string& text, const std::string& file, std::vector<ScriptCommand>* out, std::string* error);
+
+}  // namespace sg::viewer
