@@ -91,6 +91,16 @@ int64_t nextOnGrid(int64_t last, int64_t startTick, uint32_t every) {
                                                                                      : from + int64_t(every);
 }
 
+/// CHCK and SNAP chunks sit exactly every `every` ticks from the start: a missing or stray one is
+/// damage, not a shorter recording.
+void expectOnGrid(const Cursor& c, uint64_t at, int64_t tick, int64_t last, int64_t startTick, uint32_t every,
+                  const char* chunk, const char* headerField, const char* noun) {
+  if (every == 0) c.fail(at, std::string("no ") + chunk + " chunk (HEAD says " + headerField + " = 0)");
+  const int64_t want = nextOnGrid(last, startTick, every);
+  if (tick != want)
+    c.fail(at, std::string("the ") + noun + " of tick " + std::to_string(want) + ", got tick " + std::to_string(tick));
+}
+
 uint64_t maxPayload(ChunkType t) {
   switch (t) {
     case ChunkType::Head: return kMaxHeadPayload;
@@ -259,11 +269,8 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
         k.tick = c.get<int64_t>("the check tick");
         k.hash = c.get<uint64_t>("the check hash");
         // CHCK chunks come exactly every checkEvery ticks: a missing or stray one is damage.
-        const int64_t wantCheck = nextOnGrid(lastCheck, r.header.startTick, r.header.checkEvery);
-        if (r.header.checkEvery == 0 || k.tick != wantCheck)
-          c.fail(at + kChunkHeaderBytes, r.header.checkEvery == 0 ? std::string("no CHCK chunk (HEAD says checkEvery = 0)")
-                                                                  : "the check of tick " + std::to_string(wantCheck) +
-                                                                        ", got tick " + std::to_string(k.tick));
+        expectOnGrid(c, at + kChunkHeaderBytes, k.tick, lastCheck, r.header.startTick, r.header.checkEvery, "CHCK",
+                     "checkEvery", "check");
         lastCheck = k.tick;
         r.checks.push_back(k);
         c.finished();
@@ -275,12 +282,8 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
         s.hash = c.get<uint64_t>("the snapshot hash");
         const uint64_t rawAt = c.offset();
         s.rawBytes = c.get<uint64_t>("the snapshot size");
-        const int64_t wantSnapshot = nextOnGrid(lastSnapshot, r.header.startTick, r.header.snapshotEvery);
-        if (r.header.snapshotEvery == 0 || s.tick != wantSnapshot)
-          c.fail(at + kChunkHeaderBytes, r.header.snapshotEvery == 0
-                                             ? std::string("no SNAP chunk (HEAD says snapshotEvery = 0)")
-                                             : "the snapshot of tick " + std::to_string(wantSnapshot) + ", got tick " +
-                                                   std::to_string(s.tick));
+        expectOnGrid(c, at + kChunkHeaderBytes, s.tick, lastSnapshot, r.header.startTick, r.header.snapshotEvery,
+                     "SNAP", "snapshotEvery", "snapshot");
         if (s.rawBytes == 0 || s.rawBytes > kMaxSnapshotRawBytes)
           c.fail(rawAt, "a snapshot size between 1 and " + std::to_string(kMaxSnapshotRawBytes) + " bytes, got " +
                             std::to_string(s.rawBytes));
