@@ -8,10 +8,7 @@
 
 #include <stb_image_write.h>
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-function"
-#include <stb_easy_font.h>
-#pragma GCC diagnostic pop
+#include "replay/report/plot.h"
 
 namespace sg {
 namespace {
@@ -28,13 +25,13 @@ std::string observationMismatch(const Observation& a, const Observation& b) {
   };
   const size_t n = size_t(a.patchesX * a.patchesZ);
   const bool sameField = a.patchesX == b.patchesX && a.patchesZ == b.patchesZ;
-  const bool sameBodies = a.bodyPosition.size() == b.bodyPosition.size() &&
-                          a.bodyOrientation.size() == b.bodyOrientation.size();
+  auto posesFit = [](const Observation& o) {
+    return o.bodyPosition.size() % 3 == 0 && o.bodyOrientation.size() == o.bodyPosition.size() / 3 * 4;
+  };
   const bool wellFormed = a.tipX.size() == n && a.tipY.size() == n && a.tipZ.size() == n && b.tipX.size() == n &&
-                          b.tipY.size() == n && b.tipZ.size() == n && a.bodyPosition.size() % 3 == 0 &&
-                          a.bodyOrientation.size() == a.bodyPosition.size() / 3 * 4;
-  if (sameField && sameBodies && wellFormed) return {};
-  if (sameField && sameBodies) return "observations with one tip per patch and a pose per body";
+                          b.tipY.size() == n && b.tipZ.size() == n && posesFit(a) && posesFit(b);
+  if (sameField && wellFormed) return {};
+  if (sameField) return "observations with one tip per patch and a pose per body";
   return shape(a) + " vs " + shape(b);
 }
 
@@ -77,7 +74,9 @@ TickDivergence measureDivergence(const Observation& a, const Observation& b, boo
     raise(d.tipMax, std::sqrt(squared));
   }
   d.tipRms = n > 0 ? std::sqrt(sumSquares / double(n)) : 0.0;
-  const size_t bodies = a.bodyPosition.size() / 3;
+  d.bodiesA = int64_t(a.bodyPosition.size() / 3);
+  d.bodiesB = int64_t(b.bodyPosition.size() / 3);
+  const size_t bodies = size_t(std::min(d.bodiesA, d.bodiesB));  // the bodies both runs have
   for (size_t i = 0; i < bodies; ++i) {
     const double* pa = &a.bodyPosition[3 * i];
     const double* pb = &b.bodyPosition[3 * i];
@@ -120,44 +119,18 @@ void divergenceColour(double t, uint8_t rgb[3]) {
 }
 
 namespace {
-/// An 8-bit RGB image being drawn.
-struct Canvas {
-  int width = 0, height = 0;
-  std::vector<uint8_t> rgb;
-  Canvas(int w, int h, const uint8_t background[3]) : width(w), height(h), rgb(size_t(w) * size_t(h) * 3) {
-    for (size_t p = 0; p < rgb.size(); p += 3) std::memcpy(&rgb[p], background, 3);
-  }
-  void fill(int x0, int y0, int x1, int y1, const uint8_t colour[3]) {
-    x0 = std::max(x0, 0), y0 = std::max(y0, 0), x1 = std::min(x1, width), y1 = std::min(y1, height);
-    for (int y = y0; y < y1; ++y)
-      for (int x = x0; x < x1; ++x) std::memcpy(&rgb[(size_t(y) * size_t(width) + size_t(x)) * 3], colour, 3);
-  }
-  /// ASCII text with its top-left corner at (x, y), stb_easy_font glyphs scaled by `scale`.
-  void text(int x, int y, const std::string& s, int scale, const uint8_t colour[3]) {
-    std::vector<char> chars(s.begin(), s.end());
-    chars.push_back('\0');
-    std::vector<char> quads(s.size() * 400 + 64);  // ~270 bytes per glyph at most
-    const int n = stb_easy_font_print(0, 0, chars.data(), nullptr, quads.data(), int(quads.size()));
-    for (int q = 0; q < n; ++q) {
-      float v0[2], v2[2];  // corners 0 and 2 of an axis-aligned quad, 16 bytes per vertex
-      std::memcpy(v0, &quads[size_t(q) * 64], sizeof v0);
-      std::memcpy(v2, &quads[size_t(q) * 64 + 32], sizeof v2);
-      fill(x + int(v0[0]) * scale, y + int(v0[1]) * scale, x + int(v2[0]) * scale, y + int(v2[1]) * scale, colour);
-    }
-  }
-  static int textWidth(const std::string& s, int scale) {
-    std::vector<char> chars(s.begin(), s.end());
-    chars.push_back('\0');
-    return stb_easy_font_width(chars.data()) * scale;
-  }
-};
-
 std::string metres(double v) {
   char buf[40];
   if (v == 0) return "0 m";
   if (std::fabs(v) >= 1e-2 && std::fabs(v) < 1e4) std::snprintf(buf, sizeof buf, "%.4g m", v);
   else std::snprintf(buf, sizeof buf, "%.3e m", v);
   return buf;
+}
+
+plot::Rgb rampColour(double t) {
+  uint8_t rgb[3];
+  divergenceColour(t, rgb);
+  return {rgb[0], rgb[1], rgb[2]};
 }
 }  // namespace
 
@@ -187,30 +160,27 @@ bool writeDivergencePng(const std::string& path, const Observation& a, const Obs
   const int mapW = int(cols * scale), mapH = int(rows * scale);
   const int width = std::max(mapW, 480);
   const int height = mapH + margin + barHeight + margin / 2 + textHeight + margin;
-  const uint8_t background[3] = {24, 24, 24}, white[3] = {235, 235, 235};
-  Canvas img(width, height, background);
+  const plot::Rgb white{235, 235, 235};
+  plot::Canvas img(width, height, plot::Rgb{24, 24, 24});
   const int mapX = (width - mapW) / 2;
   for (int64_t r = 0; r < rows; ++r)
     for (int64_t c = 0; c < cols; ++c) {
       const double d = cell[size_t(r * cols + c)];
-      uint8_t colour[3];
-      divergenceColour(maxDist > 0 ? d / maxDist : (std::isfinite(d) ? 0.0 : 1.0), colour);
+      const plot::Rgb colour = rampColour(maxDist > 0 ? d / maxDist : (std::isfinite(d) ? 0.0 : 1.0));
       img.fill(mapX + int(c * scale), int(r * scale), mapX + int((c + 1) * scale), int((r + 1) * scale), colour);
     }
   // Legend: the ramp from 0 to the largest distance, labelled underneath.
   const int barY = mapH + margin, barX0 = margin, barX1 = width - margin;
   for (int x = barX0; x < barX1; ++x) {
-    uint8_t colour[3];
-    divergenceColour(double(x - barX0) / double(std::max(1, barX1 - barX0 - 1)), colour);
-    img.fill(x, barY, x + 1, barY + barHeight, colour);
+    img.fill(x, barY, x + 1, barY + barHeight, rampColour(double(x - barX0) / double(std::max(1, barX1 - barX0 - 1))));
   }
   const int textY = barY + barHeight + margin / 2;
   img.text(barX0, textY, "0", textScale, white);
   const std::string middle = "tip distance, tick " + std::to_string(a.tick);
-  img.text((width - Canvas::textWidth(middle, textScale)) / 2, textY, middle, textScale, white);
+  img.text((width - plot::Canvas::textWidth(middle, textScale)) / 2, textY, middle, textScale, white);
   const std::string right = metres(maxDist);
-  img.text(barX1 - Canvas::textWidth(right, textScale), textY, right, textScale, white);
-  if (!stbi_write_png(path.c_str(), width, height, 3, img.rgb.data(), width * 3)) {
+  img.text(barX1 - plot::Canvas::textWidth(right, textScale), textY, right, textScale, white);
+  if (!stbi_write_png(path.c_str(), width, height, 3, img.img.rgb.data(), width * 3)) {
     if (error) *error = path + ": expected a writable file for the heat map (cannot write it)";
     return false;
   }

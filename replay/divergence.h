@@ -18,11 +18,14 @@ struct TickDivergence {
   double bodyPosMax = 0;     ///< m: largest distance between corresponding body centres
   double bodyAngleMax = 0;   ///< rad: largest angle of the relative rotation of a body (0 … pi)
   int64_t contactsA = 0, contactsB = 0;  ///< body contacts found in the tick that led here
+  /// Bodies in each run (spawn commands add bodies mid-run): the pose errors cover the bodies
+  /// both runs have (the same indices); a body only one run has counts as a difference.
+  int64_t bodiesA = 0, bodiesB = 0;
   bool identical = false;    ///< the two state hashes are equal
 
-  /// Anything measured differs (tips, body poses or contact counts).
+  /// Anything measured differs (tips, body poses, body or contact counts).
   bool observedDifference() const {
-    return tipMax > 0 || bodyPosMax > 0 || bodyAngleMax > 0 || contactsA != contactsB;
+    return tipMax > 0 || bodyPosMax > 0 || bodyAngleMax > 0 || contactsA != contactsB || bodiesA != bodiesB;
   }
 };
 
@@ -43,8 +46,9 @@ struct DivergenceSummary {
   double tipRms() const;
 };
 
-/// Empty when `a` and `b` observe fields of the same size with the same number of bodies, else
-/// what differs ("151 x 151 patches vs 31 x 31").
+/// Empty when `a` and `b` observe fields of the same size (with any number of bodies each: a
+/// run may have spawned bodies the other has not), else what differs ("151 x 151 patches, 1
+/// bodies vs 31 x 31 patches, 1 bodies").
 std::string observationMismatch(const Observation& a, const Observation& b);
 
 /// Measures a against b. Throws std::invalid_argument (observationMismatch's text) when they

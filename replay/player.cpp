@@ -54,12 +54,13 @@ Player::Player(const sgr::Recording& recording, int threads, const VariantSettin
   } catch (const ScenarioError& e) {
     throw sgr::RecordingError(recording.file, sgr::kPreambleBytes, std::string("a scenario this build can run: ") + e.what());
   }
-  const int64_t bodies = world_->counts().bodies;
+  // Spawn commands add bodies up to kMaxBodies: commands may name those indices too.
+  const int64_t bodies = std::max<int64_t>(world_->counts().bodies, kMaxBodies);
   for (const sgr::InputRecord& in : recording.inputs)
     for (const BodyCommand& c : in.input.bodies)
       if (c.body >= bodies)
         throw sgr::RecordingError(recording.file, in.offset,
-                                  "commands for the scenario's " + std::to_string(bodies) + " bodies, got body " +
+                                  "commands for at most " + std::to_string(bodies) + " bodies, got body " +
                                       std::to_string(c.body) + " at tick " + std::to_string(in.tick));
   if (sameSettings_ && world_->stateHash() != recording.header.initialStateHash && recording.header.startTick == 0)
     throw sgr::RecordingError(recording.file, sgr::kPreambleBytes,

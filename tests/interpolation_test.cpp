@@ -101,3 +101,71 @@ TEST(PatchState, SmallerCapAndTiltLevelsFollowTheThesis) {
 
 }  // namespace
 }  // namespace sg
+
+namespace sg {
+namespace {
+
+// The patch stage runs k = 2 and 4 with compile-time weights (sim/patches/patch_state.h): it
+// must give the same bits as the generic row with runtime weights, in every scalar and in a
+// wrapped level-of-detail window (rows and columns stored toroidally).
+template <class S>
+void checkConstantWeightRowsMatchGeneric(int k) {
+  Scenario s = test::thesisMeadow();
+  s.field.patchesX = 161;
+  s.field.patchesZ = 145;
+  s.particles.interpolation = k;
+  s.wind.travelSpeed = Rational{1, 2};
+  s.scalar = ScalarTraits<S>::kind;
+  s.lod.mode = LodMode::Window;
+  s.lod.windowX = 15;  // particles
+  s.lod.windowZ = 13;
+  World<S> w(s, 1);
+  TickInput in;
+  in.hasCamera = true;
+  for (int t = 0; t < 60; ++t) {
+    in.camera = InputVec3{int64_t(t % 30) << 30, 0, int64_t(t % 25) << 29};  // drags the window around
+    ASSERT_TRUE(w.step(in).ok);
+  }
+  ASSERT_TRUE(w.patchWindow().originI != 0 || w.patchWindow().originJ != 0) << "the window must have moved";
+  // Inputs of the row function, as the world's patch stage sees them.
+  const auto& p = w.particles();
+  const ParticleGrid& g = w.particleGrid();
+  const S rod = w.particleConstants().rodLength;
+  std::vector<S> dx(size_t(g.size())), dy(dx), dz(dx);
+  particleDisplacement(p, 0, g.size(), rod, dx, dy, dz);
+  PatchStateConstants<S> c;
+  c.k = k;
+  for (int t = 0; t < k; ++t) c.weight.push_back(*ScalarTraits<S>::fromRational(*Rational::make(t, k)));
+  c.rodLength = rod;
+  c.halfRod = rod / S(2);
+  c.scaleY = S(1);
+  c.minimumTop = S(0);
+  ASSERT_TRUE(rowWeightsAreExact(c));
+  const LatticeWindow& pw = w.patchWindow();
+  PatchArrays<S> generic = w.patches(), constant = w.patches();
+  std::vector<S> scratch(size_t(3 * (g.countX + pw.sizeI)));
+  int64_t compared = 0;
+  for (int64_t j = pw.originJ; j < pw.originJ + pw.sizeJ; ++j) {
+    updatePatchRow<S>(generic, pw, j, g.window, dx, dy, dz, c, scratch.data());
+    if (k == 2) updatePatchRow<S, 2>(constant, pw, j, g.window, dx, dy, dz, c, scratch.data());
+    else updatePatchRow<S, 4>(constant, pw, j, g.window, dx, dy, dz, c, scratch.data());
+    compared += pw.sizeI;
+  }
+  EXPECT_EQ(compared, pw.sizeI * pw.sizeJ);
+  EXPECT_TRUE(generic.tipOffsetX == constant.tipOffsetX);
+  EXPECT_TRUE(generic.tipOffsetZ == constant.tipOffsetZ);
+  EXPECT_TRUE(generic.topY == constant.topY);
+  EXPECT_TRUE(generic.tiltLevel == constant.tiltLevel);
+  // And the world's own patch stage produced the same tips (it picks the constant path).
+  EXPECT_TRUE(generic.tipOffsetX == w.patches().tipOffsetX);
+  EXPECT_TRUE(generic.tipOffsetZ == w.patches().tipOffsetZ);
+}
+
+TEST(PatchState, ConstantWeightRowsGiveTheGenericBitsK2Fx32) { checkConstantWeightRowsMatchGeneric<Fx32>(2); }
+TEST(PatchState, ConstantWeightRowsGiveTheGenericBitsK4Fx32) { checkConstantWeightRowsMatchGeneric<Fx32>(4); }
+TEST(PatchState, ConstantWeightRowsGiveTheGenericBitsK2Fx16) { checkConstantWeightRowsMatchGeneric<Fx16>(2); }
+TEST(PatchState, ConstantWeightRowsGiveTheGenericBitsK4Double) { checkConstantWeightRowsMatchGeneric<double>(4); }
+TEST(PatchState, ConstantWeightRowsGiveTheGenericBitsK2Float) { checkConstantWeightRowsMatchGeneric<float>(2); }
+
+}  // namespace
+}  // namespace sg

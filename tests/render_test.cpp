@@ -1,4 +1,4 @@
-// The renderer and `simgrass render` (docs/rendering.md): three fixed views of fixed ticks are
+// The renderer and `simgrass render` (docs/rendering.md): four fixed views of fixed ticks are
 // rendered offscreen (OSMesa, 320x240, 4x MSAA) and compared with the committed PNGs in
 // tests/golden/images/ within a tolerance meant for other Mesa versions; each view must also
 // differ substantially from a sky-only frame, so a renderer that draws nothing fails. The command
@@ -94,6 +94,7 @@ struct GoldenView {
   const char* scenario;  ///< scenarios/<scenario>
   int64_t tick;
   std::optional<Camera> camera;  ///< nullopt: the default camera
+  bool ssao = false;             ///< RenderOptions::ssao (the rest: defaults)
 };
 
 Camera fixedCamera(float x, float y, float z, float yaw, float pitch) {
@@ -119,7 +120,9 @@ Image renderView(const GoldenView& v, Image* sky) {
   viewer::Scene& scene = r.scene();
   viewer::extractScene(*world, scenario, &scene);
   const Camera camera = v.camera ? *v.camera : viewer::defaultCamera(scene, *world);
+  r.options().ssao = v.ssao;
   Image image = r.render(scene, camera);
+  r.options().ssao = false;
   if (sky) {
     viewer::Scene empty;  // no tufts, no bodies, no ground: only the sky pass draws
     empty.atlasVariants = scene.atlasVariants;
@@ -187,6 +190,14 @@ TEST(Render, GoldenThesisBodiesTick90) {
 // The painted football field and the mower's cut lane, from above and behind the mower.
 TEST(Render, GoldenMowerFieldTick200) {
   checkGolden({"mower-field-200", "mower-field.json", 200, fixedCamera(-19, 4.5f, -1, 60, -30)});
+}
+
+// The hills with ambient occlusion and the rock blend, looking over the steepest slopes (under
+// the grass, and bare beyond the field).
+TEST(Render, GoldenHillyMeadowSsaoTick60) {
+  GoldenView v{"hilly-meadow-ssao-60", "hilly-meadow.json", 60, fixedCamera(-6, 12, -14, 52, -24)};
+  v.ssao = true;
+  checkGolden(v);
 }
 
 // ---- renderer properties ---------------------------------------------------------------------

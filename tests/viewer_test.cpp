@@ -10,7 +10,8 @@
 #include "tests/test_support.h"
 
 namespace sg {
-namespace {
+namespace viewer_test {
+// Shared with tests/viewer_playback_test.cpp (declared there).
 
 bool onPath(const std::string& program) {
   return std::system(("command -v " + program + " >/dev/null 2>&1").c_str()) == 0;
@@ -20,7 +21,9 @@ bool onPath(const std::string& program) {
 CliResult runViewer(const std::string& args, bool xvfb = true) {
   TempDir dir;
   const std::string out = dir.file("stdout"), err = dir.file("stderr");
-  const std::string prefix = xvfb ? "xvfb-run -a -s '-screen 0 1024x768x24' " : "";
+  // xvfb-run's own temporary folder (X authority file) goes into this test's folder: in the
+  // shared /tmp another process's clean-up could remove it first and fail the run (exit 5).
+  const std::string prefix = xvfb ? "env TMPDIR=" + quote(dir.file("")) + " xvfb-run -a -s '-screen 0 1024x768x24' " : "";
   const std::string cmd = "timeout -k 5 120 " + prefix + quote(SIMGRASS_VIEWER) + " " + args + " </dev/null >" +
                           quote(out) + " 2>" + quote(err);
   const int status = std::system(cmd.c_str());
@@ -31,6 +34,12 @@ CliResult runViewer(const std::string& args, bool xvfb = true) {
   r.err = readFile(err);
   return r;
 }
+
+}  // namespace viewer_test
+
+namespace {
+using viewer_test::onPath;
+using viewer_test::runViewer;
 
 /// The hash in the viewer's "recorded   N ticks to PATH (hash H)" line.
 std::string recordedHash(const std::string& out) {

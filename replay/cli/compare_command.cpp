@@ -47,15 +47,6 @@ struct Row {
   }
 };
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(mid), v.end());
-  const double upper = v[mid];
-  if (v.size() % 2 == 1) return upper;
-  return (*std::max_element(v.begin(), v.begin() + std::ptrdiff_t(mid)) + upper) / 2.0;
-}
-
 double msSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -203,7 +194,7 @@ int compare(const CompareOptions& o) {
     std::fprintf(stderr, "simgrass compare: --variant %s: %s\n", row.name.c_str(), row.status().c_str());
     code = kExitMismatch;
   }
-  const double refMs = median(ref.msPerTick);
+  const double refMs = medianOf(ref.msPerTick);
   const std::string refVerified =
       ref.firstMismatchTick >= 0 ? "DIFFERS from the recording from tick " + std::to_string(ref.firstMismatchTick)
       : ref.hashesChecked > 0    ? "verified (" + std::to_string(ref.hashesChecked) + " recorded hashes match)"
@@ -218,7 +209,7 @@ int compare(const CompareOptions& o) {
         for (const Row& r : rows)
           std::fprintf(f, "%s,%s,%d,%s,%s,%s,%s,%s,%s,%" PRId64 ",%" PRId64 ",%s,%" PRId64 "\n", csvField(r.name).c_str(),
                        csvField(r.resolved).c_str(), r.mustBeIdentical ? 1 : 0, csvField(r.status()).c_str(),
-                       csvNumber(median(r.msPerTick)).c_str(), csvNumber(r.summary.tipMax).c_str(),
+                       csvNumber(medianOf(r.msPerTick)).c_str(), csvNumber(r.summary.tipMax).c_str(),
                        csvNumber(r.summary.tipRms()).c_str(), csvNumber(r.summary.bodyPosMax).c_str(),
                        csvNumber(r.summary.bodyAngleMax).c_str(), r.summary.contactDeltaMax, r.firstDivergentTick(),
                        r.mustBeIdentical ? "hash" : "observation", r.summary.ticks);
@@ -254,7 +245,7 @@ int compare(const CompareOptions& o) {
                           {"mustBeIdentical", r.mustBeIdentical},
                           {"status", r.status()},
                           {"failed", r.failed()},
-                          {"msPerTick", median(r.msPerTick)},
+                          {"msPerTick", medianOf(r.msPerTick)},
                           {"substepsPerTick", r.substeps},
                           {"ticksPerStep", r.recordedTicksPerStep},
                           {"statesCompared", r.summary.ticks},
@@ -279,7 +270,7 @@ int compare(const CompareOptions& o) {
       const std::string diverges =
           first < 0 ? "never" : std::to_string(first) + (r.mustBeIdentical ? " (h)" : " (o)");
       std::printf("%-*s  %8.3f  %11s  %11s  %11s  %11s  %8" PRId64 "  %9s  %s\n", int(w), r.name.c_str(),
-                  median(r.msPerTick), shortNumber(r.summary.tipMax).c_str(), shortNumber(r.summary.tipRms()).c_str(),
+                  medianOf(r.msPerTick), shortNumber(r.summary.tipMax).c_str(), shortNumber(r.summary.tipRms()).c_str(),
                   shortNumber(r.summary.bodyPosMax).c_str(), shortNumber(r.summary.bodyAngleMax).c_str(),
                   r.summary.contactDeltaMax, diverges.c_str(), r.status().c_str());
     }

@@ -3,6 +3,7 @@
 #include <cinttypes>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -61,6 +62,15 @@ void writeTickCsvRow(std::FILE* f, const TickDivergence& d) {
   std::fprintf(f, "%" PRId64 ",%s,%s,%s,%s,%" PRId64 ",%" PRId64 ",%d\n", d.tick, csvNumber(d.tipMax).c_str(),
                csvNumber(d.tipRms).c_str(), csvNumber(d.bodyPosMax).c_str(), csvNumber(d.bodyAngleMax).c_str(),
                d.contactsA, d.contactsB, d.identical ? 1 : 0);
+}
+
+double medianOf(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(mid), v.end());
+  const double upper = v[mid];
+  if (v.size() % 2 == 1) return upper;
+  return (*std::max_element(v.begin(), v.begin() + std::ptrdiff_t(mid)) + upper) / 2.0;
 }
 
 void summaryJson(const DivergenceSummary& s, nlohmann::json& out) {

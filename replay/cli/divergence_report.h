@@ -6,6 +6,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "replay/divergence.h"
 #include "replay/format/sgr_reader.h"
@@ -31,6 +32,9 @@ std::string csvNumber(double v);
 std::string csvField(const std::string& s);
 /// A length or angle for a text table: "0" or 3 significant digits in exponent form.
 std::string shortNumber(double v);
+
+/// The median of `v` (the mean of the two middle values for an even count; 0 when empty).
+double medianOf(std::vector<double> v);
 
 /// The run-level numbers of a summary (metres, radians) as JSON keys.
 void summaryJson(const DivergenceSummary& s, nlohmann::json& out);

@@ -9,6 +9,7 @@
 #include "replay/cli/render_command.h"
 #include "replay/cli/replay_command.h"
 #include "replay/cli/run_command.h"
+#include "replay/cli/sweep_command.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"SimGrass: deterministic fixed-point grass physics testbed", "simgrass"};
@@ -20,6 +21,7 @@ int main(int argc, char** argv) {
   sg::addReplayCommand(app, &exitCode);
   sg::addDiffCommand(app, &exitCode);
   sg::addCompareCommand(app, &exitCode);
+  sg::addSweepCommand(app, &exitCode);
   sg::addRenderCommand(app, &exitCode);
   try {
     app.parse(argc, argv);

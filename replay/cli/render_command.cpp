@@ -27,11 +27,32 @@ namespace {
 namespace fs = std::filesystem;
 
 struct RenderOptions {
-  std::string input, output, ticks = "0", size = "800x600", camera, contactSheet, video;
+  std::string input, output, ticks = "0", size = "800x600", camera, contactSheet, video, debug;
   int msaa = 4;
   int threads = 1;
   bool json = false;
+  bool ssao = false, alphaTest = false, noRock = false;
 };
+
+/// "particles,constraints,primitives,cells,contacts" (any subset, comma-separated).
+bool parseDebugList(const std::string& list, viewer::DebugFlags* flags, std::string* bad) {
+  *flags = {};
+  if (list.empty()) return true;
+  std::string item;
+  std::istringstream in(list);
+  bool any = false;
+  while (std::getline(in, item, ',')) {
+    any = true;
+    if (item == "particles") flags->particles = true;
+    else if (item == "constraints") flags->constraints = true;
+    else if (item == "primitives") flags->primitives = true;
+    else if (item == "cells") flags->cells = true;
+    else if (item == "contacts") flags->contacts = true;
+    else return *bad = item, false;
+  }
+  if (!any || list.back() == ',') return *bad = "", false;
+  return true;
+}
 
 constexpr int64_t kMaxFrames = 1000000;
 
@@ -243,6 +264,11 @@ int render(const RenderOptions& o) {
   }
   if (o.msaa != 0 && o.msaa != 2 && o.msaa != 4 && o.msaa != 8)
     return fail(kExitBadInput, "--msaa: expected 0, 2, 4 or 8, got " + std::to_string(o.msaa));
+  viewer::DebugFlags debug;
+  std::string badItem;
+  if (!parseDebugList(o.debug, &debug, &badItem))
+    return fail(kExitBadInput, "--debug: expected a comma list of particles, constraints, primitives, cells, contacts, got '" +
+                                   o.debug + "'" + (badItem.empty() ? "" : " ('" + badItem + "')"));
 
   // ---- the world ----
   Scenario scenario;
@@ -279,6 +305,13 @@ int render(const RenderOptions& o) {
   std::unique_ptr<viewer::OffscreenRenderer> renderer =
       viewer::OffscreenRenderer::create(width, height, o.msaa, &error);
   if (!renderer) return fail(kExitMismatch, error);
+  renderer->options().ssao = o.ssao;
+  renderer->options().alphaToCoverage = !o.alphaTest;
+  renderer->options().rockBlend = !o.noRock;
+  renderer->options().debug = debug;
+  // Scenario meshes are named relative to the scenario file (a recording carries its scenario
+  // text, not its folder: relative meshes resolve against the recording's folder).
+  renderer->renderer().setAssetDirectory(fs::path(o.input).parent_path().string());
 
   // ---- frames ----
   std::vector<int64_t> ticks;
@@ -287,6 +320,7 @@ int render(const RenderOptions& o) {
   std::vector<double> simMsPerTick, extractMs, renderMs, writeMs;
   std::vector<viewer::Image> thumbs;
   std::vector<std::string> files;
+  std::string assetNote;  // the first mesh that failed to load
   const int thumbW = std::min(width, 320), thumbH = std::max(1, height * thumbW / width);
   using Clock = std::chrono::steady_clock;
   auto ms = [](Clock::time_point a, Clock::time_point b) {
@@ -310,6 +344,7 @@ int render(const RenderOptions& o) {
 
       viewer::Scene& scene = renderer->scene();
       viewer::extractScene(world, scenario, &scene);
+      viewer::extractDebug(world, scenario, debug, &scene);
       const auto t2 = Clock::now();
       extractMs.push_back(ms(t1, t2));
       viewer::Camera camera;
@@ -324,6 +359,10 @@ int render(const RenderOptions& o) {
       double frameMs = 0;
       const viewer::Image image = renderer->render(scene, camera, &frameMs);
       renderMs.push_back(frameMs);
+      if (!renderer->renderer().lastAssetError().empty() && assetNote.empty()) {
+        assetNote = renderer->renderer().lastAssetError();
+        std::fprintf(stderr, "simgrass render: note: %s (drawing the body's primitives)\n", assetNote.c_str());
+      }
 
       char name[32];
       std::snprintf(name, sizeof name, "frame-%06" PRId64 ".png", tick);
@@ -378,6 +417,11 @@ int render(const RenderOptions& o) {
     j["width"] = width;
     j["height"] = height;
     j["msaa"] = renderer->samples();
+    j["alphaToCoverage"] = renderer->samples() > 0 && !o.alphaTest;
+    j["ssao"] = o.ssao;
+    j["rockBlend"] = !o.noRock;
+    j["debug"] = o.debug;
+    if (!assetNote.empty()) j["assetError"] = assetNote;
     j["renderer"] = gl;
     j["tufts"] = renderer->scene().tufts.size();
     j["medianSimulationMsPerTick"] = median(simMsPerTick);
@@ -413,6 +457,13 @@ void addRenderCommand(CLI::App& app, int* exitCode) {
                   "input's camera track if any, else 1.7 m above the ground at the -z edge of the simulated grass, "
                   "looking at its centre");
   cmd->add_option("--msaa", o->msaa, "Samples per pixel: 0 (alpha test) or 2/4/8 (alpha to coverage; default 4)");
+  cmd->add_flag("--ssao", o->ssao,
+                "Screen-space ambient occlusion (depth prepass where the tufts' alpha passes, half resolution)");
+  cmd->add_flag("--alpha-test", o->alphaTest, "Alpha-test the tufts even with MSAA (no alpha to coverage)");
+  cmd->add_option("--debug", o->debug,
+                  "Debug overlay, a comma list of: particles, constraints (root-particle rods), primitives (body "
+                  "collision shapes), cells (body-particle broad-phase cells), contacts (points + normals)");
+  cmd->add_flag("--no-rock", o->noRock, "No rock texture on steep terrain (grass texture everywhere)");
   cmd->add_option("--contact-sheet", o->contactSheet, "Also write a grid of thumbnails of every frame (PNG)");
   cmd->add_option("--video", o->video,
                   "Also encode the frames with ffmpeg (skipped with a note when ffmpeg is missing)");

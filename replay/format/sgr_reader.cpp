@@ -192,8 +192,8 @@ void parseInput(Recording& r, Cursor& c, TickInput& camera) {
     if (cmd.body < 0) c.fail(bodyAt, "a body index >= 0, got " + std::to_string(cmd.body));
     const uint64_t kindAt = c.offset();
     const uint8_t kind = c.get<uint8_t>("a command kind");
-    if (kind > uint8_t(BodyCommandKind::Teleport))
-      c.fail(kindAt, "a command kind 0.." + std::to_string(int(BodyCommandKind::Teleport)) + ", got " + std::to_string(kind));
+    if (kind > uint8_t(BodyCommandKind::MowerOff))
+      c.fail(kindAt, "a command kind 0.." + std::to_string(int(BodyCommandKind::MowerOff)) + ", got " + std::to_string(kind));
     cmd.kind = BodyCommandKind(kind);
     cmd.value = c.vec3("a command value");
     rec.input.bodies.push_back(cmd);

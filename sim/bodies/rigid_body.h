@@ -38,6 +38,7 @@ struct RigidBody {
   Vec3<S> angularVelocity = Vec3<S>::Zero();   ///< rad/s, world frame
   int32_t stillTicks = 0;                      ///< consecutive ticks below the sleep thresholds
   bool asleep = false;                         ///< skips gravity and integration until woken
+  bool bladeOn = true;                         ///< a mower cuts only while on (MowerOn/MowerOff)
   // --- derived from the state (recomputed by updateDerived) ----------------------------------
   Mat3<S> rotation = Mat3<S>::Identity();
   Mat3<S> invInertiaWorld = Mat3<S>::Zero();

@@ -10,6 +10,7 @@
 //     tilt      = 3 if d.y < -drop[2], 2 if < -drop[1], 1 if < -drop[0], else 0
 #pragma once
 
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -39,30 +40,81 @@ inline void particleDisplacement(const ParticleArrays<S>& p, int64_t begin, int6
   }
 }
 
-/// Writes one patch's derived state from its tip displacement (ddx, ddy, ddz).
+/// Writes patches' derived state from their tip displacement. Holds raw pointers and the
+/// constants by value: a tilt store (uint8_t) may alias anything, so code indexing the vectors
+/// through PatchArrays would reload every data pointer and constant after each patch.
 template <class S>
-inline void writePatch(PatchArrays<S>& patches, size_t p, S ddx, S ddy, S ddz, const PatchStateConstants<S>& c) {
-  const S zero(0);
-  patches.tipOffsetX[p] = ddx;
-  patches.tipOffsetZ[p] = ddz;
-  const S sink = zero - ddy;
-  const S smaller = sink < zero ? zero : (sink > c.halfRod ? c.halfRod : sink);
-  // Thesis: top = root + scaleY - scaleYMinus - smaller; scaleYMinus is set by the mower.
-  const S top = c.scaleY - smaller - (patches.cut[p] ? c.cutReduction : zero);
-  patches.topY[p] = patches.rootY[p] + (top < c.minimumTop ? c.minimumTop : top);
-  patches.tiltLevel[p] = uint8_t(sink > c.drop[2] ? 3 : sink > c.drop[1] ? 2 : sink > c.drop[0] ? 1 : 0);
+struct PatchWriter {
+  S* tipOffsetX;
+  S* tipOffsetZ;
+  S* topY;
+  uint8_t* tiltLevel;
+  const S* rootY;
+  const uint8_t* cut;
+  S halfRod, scaleY, cutReduction, minimumTop, drop0, drop1, drop2;
+
+  PatchWriter(PatchArrays<S>& patches, const PatchStateConstants<S>& c)
+      : tipOffsetX(patches.tipOffsetX.data()), tipOffsetZ(patches.tipOffsetZ.data()), topY(patches.topY.data()),
+        tiltLevel(patches.tiltLevel.data()), rootY(patches.rootY.data()), cut(patches.cut.data()),
+        halfRod(c.halfRod), scaleY(c.scaleY), cutReduction(c.cutReduction), minimumTop(c.minimumTop),
+        drop0(c.drop[0]), drop1(c.drop[1]), drop2(c.drop[2]) {}
+
+  /// Writes patch p from its tip displacement (ddx, ddy, ddz).
+  void write(size_t p, S ddx, S ddy, S ddz) const {
+    const S zero(0);
+    tipOffsetX[p] = ddx;
+    tipOffsetZ[p] = ddz;
+    const S sink = zero - ddy;
+    const S smaller = sink < zero ? zero : (sink > halfRod ? halfRod : sink);
+    // Thesis: top = root + scaleY - scaleYMinus - smaller; scaleYMinus is set by the mower.
+    const S top = scaleY - smaller - (cut[p] ? cutReduction : zero);
+    topY[p] = rootY[p] + (top < minimumTop ? minimumTop : top);
+    tiltLevel[p] = uint8_t(sink > drop2 ? 3 : sink > drop1 ? 2 : sink > drop0 ? 1 : 0);
+  }
+};
+
+/// t / K as a constant, for K a power of two: exact in every scalar (the runtime weight
+/// c.weight[t] holds the same value; rowWeightsAreExact checks), so the compiler turns the
+/// multiplications by it into shifts and unrolls the patches between two particles.
+template <class S, int K>
+inline S powerOfTwoWeight(int t) {
+  static_assert(K > 1 && (K & (K - 1)) == 0, "K must be a power of two");
+  if constexpr (ScalarTraits<S>::isFixed) {
+    return S::fromRaw(typename S::RawType(t) << (S::kFracBits - std::countr_zero(unsigned(K))));
+  } else {
+    return S(t) / S(K);
+  }
+}
+
+/// True when c.k is 2 or 4 and every c.weight[t] equals powerOfTwoWeight (then updatePatchRow
+/// may run with K = c.k and give the same bits as K = 0).
+template <class S>
+inline bool rowWeightsAreExact(const PatchStateConstants<S>& c) {
+  auto check = [&]<int K>() {
+    for (int t = 0; t < K; ++t)
+      if (!(c.weight[size_t(t)] == powerOfTwoWeight<S, K>(t))) return false;
+    return true;
+  };
+  return c.k == 2 ? check.template operator()<2>() : c.k == 4 ? check.template operator()<4>() : false;
 }
 
 /// Derived state of patch row j (a lattice row of `patchWindow`) for interpolation k > 1 (with
-/// k = 1 patch and particle storage coincide and writePatch runs straight over them).
+/// k = 1 patch and particle storage coincide and PatchWriter runs straight over them).
 /// `particles` is the particle window (toroidal, sim/lod/lattice_window.h); the patch window
 /// covers patch columns [k originI, k (originI + sizeI - 1)] at most, so every patch lies between
-/// two held particles. `scratch` holds 3 * particles.sizeI values.
-template <class S>
+/// two held particles. `scratch` holds 3 * (particles.sizeI + patchWindow.sizeI) values. K = 0 takes k and the weights
+/// from `c`; K = c.k (2 or 4, when rowWeightsAreExact) uses constant weights: the same bits,
+/// about a third fewer instructions.
+template <class S, int K = 0>
 inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWindow, int64_t j,
                            const LatticeWindow& particles, const std::vector<S>& dx, const std::vector<S>& dy,
                            const std::vector<S>& dz, const PatchStateConstants<S>& c, S* scratch) {
-  const int k = c.k;
+  const int k = K != 0 ? K : c.k;
+  const S* weight = c.weight.data();
+  auto weightOf = [weight](int t) {
+    if constexpr (K != 0) return powerOfTwoWeight<S, K>(t);
+    else return weight[t];
+  };
   const int64_t b0 = j / k, tz = j % k;
   const int64_t nx = particles.sizeI;
   // Row of displacements at this patch row's z: particle row b0, or a blend of b0 and b0+1, in
@@ -73,39 +125,52 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
   const S* rz = dz.data() + r0;
   if (tz != 0) {
     const int64_t r1 = particles.storageRow(b0 + 1) * nx;
-    const S w = c.weight[size_t(tz)];
+    const S* sx = dx.data() + r1;
+    const S* sy = dy.data() + r1;
+    const S* sz = dz.data() + r1;
+    const S w = weightOf(int(tz));
     S* bx = scratch;
     S* by = scratch + nx;
     S* bz = scratch + 2 * nx;
     for (int64_t a = 0; a < nx; ++a) {
-      bx[a] = lerp(rx[a], dx[size_t(r1 + a)], w);
-      by[a] = lerp(ry[a], dy[size_t(r1 + a)], w);
-      bz[a] = lerp(rz[a], dz[size_t(r1 + a)], w);
+      bx[a] = lerp(rx[a], sx[a], w);
+      by[a] = lerp(ry[a], sy[a], w);
+      bz[a] = lerp(rz[a], sz[a], w);
     }
     rx = bx;
     ry = by;
     rz = bz;
   }
-  // Walk particle columns (storage column sa, wrapping) and the k patches after each
-  // (i = k a + t): no division per patch. Patch storage columns wrap the same way.
-  const int64_t rowBase = patchWindow.storageRow(j) * patchWindow.sizeI;
+  // Along x, into the patch row's displacements in patch storage order: walk particle columns
+  // (storage column sa, wrapping) and the k patches after each (i = k a + t), no division per
+  // patch; patch storage columns wrap the same way. Then the derived state in one contiguous
+  // pass. (Two short loops keep few values live: one loop doing both spills to the stack.)
+  const int64_t rowSize = patchWindow.sizeI, endI = patchWindow.endI();
+  S* qx = scratch + 3 * nx;
+  S* qy = qx + rowSize;
+  S* qz = qy + rowSize;
   int64_t sa = particles.storageColumn(patchWindow.originI / k);
   int64_t sp = patchWindow.storageColumn(patchWindow.originI);
-  for (int64_t i = patchWindow.originI; i < patchWindow.endI();) {
+  for (int64_t i = patchWindow.originI; i < endI;) {
     const int64_t sb = sa + 1 == nx ? 0 : sa + 1;
-    for (int t = 0; t < k && i < patchWindow.endI(); ++t, ++i) {
+    for (int t = 0; t < k && i < endI; ++t, ++i) {
       S ddx = rx[sa], ddy = ry[sa], ddz = rz[sa];
       if (t != 0) {
-        const S w = c.weight[size_t(t)];
+        const S w = weightOf(t);
         ddx = lerp(ddx, rx[sb], w);
         ddy = lerp(ddy, ry[sb], w);
         ddz = lerp(ddz, rz[sb], w);
       }
-      writePatch(patches, size_t(rowBase + sp), ddx, ddy, ddz, c);
-      sp = sp + 1 == patchWindow.sizeI ? 0 : sp + 1;
+      qx[sp] = ddx;
+      qy[sp] = ddy;
+      qz[sp] = ddz;
+      sp = sp + 1 == rowSize ? 0 : sp + 1;
     }
     sa = sb;
   }
+  const PatchWriter<S> out(patches, c);
+  const size_t rowBase = size_t(patchWindow.storageRow(j) * rowSize);
+  for (int64_t q = 0; q < rowSize; ++q) out.write(rowBase + size_t(q), qx[q], qy[q], qz[q]);
 }
 
 }  // namespace sg

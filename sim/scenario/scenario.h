@@ -63,6 +63,9 @@ struct BodySpec {
   Rational friction{1, 2};
   bool mower = false;             ///< cuts the grass it touches
   bool canSleep = true;           ///< may sleep when it has been still for a while (thesis: "ability to sleep")
+  /// Optional OBJ file for the renderer's looks only (as written in the JSON, relative to the
+  /// scenario file's directory); never affects the simulation or the state hash.
+  std::string mesh;
 };
 
 /// One scripted command (the scenario's input track).
@@ -71,7 +74,14 @@ enum class BodyCommandKind : uint8_t {
   AddVelocity,  ///< velocity += value (thesis "velocity movement")
   Impulse,      ///< velocity += value / mass
   Teleport,     ///< position = value, velocities = 0
+  Reset,        ///< back to the scenario start state (position, orientation, rest); value ignored
+  Spawn,        ///< append a new body: a copy of body `body`'s spec at value (m), at rest,
+                ///< with the template's initial orientation; at most kMaxBodies, else ignored
+  MowerOn,      ///< a mower's blade cuts again (mowers start on); ignored for other bodies
+  MowerOff,     ///< a mower's blade stops cutting (the body still collides); ignored for others
 };
+/// Scenario bodies plus spawned ones never exceed this; a Spawn beyond it is ignored.
+inline constexpr int kMaxBodies = 64;
 /// A camera key of a camera track: the camera sits at `position` from `tick` until the next key.
 struct CameraKey {
   int64_t tick = 0;

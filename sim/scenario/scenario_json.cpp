@@ -317,7 +317,7 @@ ShapeSpec parseShapePart(const Reader& r, const json& j, const std::string& p, b
 BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
   BodySpec b;
   r.object(j, p, {"name", "shape", "mass", "position", "orientation", "velocity", "angularVelocity", "linearDamping",
-                  "angularDamping", "restitution", "friction", "mower", "canSleep"});
+                  "angularDamping", "restitution", "friction", "mower", "canSleep", "mesh"});
   if (!j.contains("name")) r.fail(p + ".name", "a body name (missing)");
   b.name = r.string(j["name"], p + ".name");
   if (!j.contains("shape")) r.fail(p + ".shape", "a shape {\"type\": \"sphere\" | \"box\" | \"compound\", ...} (missing)");
@@ -363,6 +363,8 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
     if (!j["canSleep"].is_boolean()) r.failGot(p + ".canSleep", "true or false", j["canSleep"]);
     b.canSleep = j["canSleep"].get<bool>();
   }
+  // Looks only (the renderer loads it); stored as written, never part of the fingerprint.
+  if (j.contains("mesh")) b.mesh = r.string(j["mesh"], p + ".mesh");
   return b;
 }
 
@@ -441,6 +443,18 @@ void parseLod(const Reader& r, const json& j, Scenario::Lod& l) {
   if (j.contains("edgeRows")) l.edgeRows = int(r.integer(j["edgeRows"], p + ".edgeRows", 0, 1000));
 }
 
+/// A command's body: a name from $.bodies.list, or an index (scenario bodies first, then spawned
+/// ones in spawn order; a command to an index that does not exist when it runs is ignored).
+int32_t scriptBody(const Reader& r, const json& body, const Scenario& s, const std::string& p) {
+  if (body.is_number_integer()) return int32_t(r.integer(body, p, 0, kMaxBodies - 1));
+  if (!body.is_string()) r.failGot(p, "a body name or index 0.." + std::to_string(kMaxBodies - 1), body);
+  const std::string name = r.string(body, p);
+  for (size_t k = 0; k < s.bodies.list.size(); ++k)
+    if (s.bodies.list[k].name == name) return int32_t(k);
+  r.failGot(p, "the name of a body in $.bodies.list", body);
+  return -1;
+}
+
 void parseScript(const Reader& r, const json& j, const Scenario& s, const std::string& p,
                  std::vector<ScriptedCommand>& script) {
   if (!j.is_array() || j.size() > 1000000) r.failGot(p, "an array of commands", j);
@@ -451,18 +465,21 @@ void parseScript(const Reader& r, const json& j, const Scenario& s, const std::s
     ScriptedCommand cmd;
     if (!c.contains("tick")) r.fail(q + ".tick", "the tick the command applies to (missing)");
     cmd.tick = r.integer(c["tick"], q + ".tick", 0, int64_t(1) << 40);
-    if (!c.contains("body")) r.fail(q + ".body", "a body name (missing)");
-    const std::string name = r.string(c["body"], q + ".body");
-    cmd.body = -1;
-    for (size_t k = 0; k < s.bodies.list.size(); ++k)
-      if (s.bodies.list[k].name == name) cmd.body = int32_t(k);
-    if (cmd.body < 0) r.failGot(q + ".body", "the name of a body in $.bodies.list", c["body"]);
+    if (!c.contains("body")) r.fail(q + ".body", "a body name or index (missing)");
+    cmd.body = scriptBody(r, c["body"], s, q + ".body");
     if (!c.contains("command")) r.fail(q + ".command", "a command (missing)");
     cmd.kind = r.choice<BodyCommandKind>(c["command"], q + ".command",
                                          {{"displace", BodyCommandKind::Displace}, {"addVelocity", BodyCommandKind::AddVelocity},
-                                          {"impulse", BodyCommandKind::Impulse}, {"teleport", BodyCommandKind::Teleport}});
-    if (!c.contains("value")) r.fail(q + ".value", "a vector [x, y, z] (missing)");
-    cmd.value = r.vector<3>(c["value"], q + ".value");
+                                          {"impulse", BodyCommandKind::Impulse}, {"teleport", BodyCommandKind::Teleport},
+                                          {"reset", BodyCommandKind::Reset}, {"spawn", BodyCommandKind::Spawn},
+                                          {"mowerOn", BodyCommandKind::MowerOn}, {"mowerOff", BodyCommandKind::MowerOff}});
+    // reset and the blade switches take no value; every other command needs one.
+    const bool needsValue = cmd.kind != BodyCommandKind::Reset && cmd.kind != BodyCommandKind::MowerOn &&
+                            cmd.kind != BodyCommandKind::MowerOff;
+    if (c.contains("value"))
+      cmd.value = r.vector<3>(c["value"], q + ".value");
+    else if (needsValue)
+      r.fail(q + ".value", "a vector [x, y, z] (missing)");
     script.push_back(cmd);
   }
   std::stable_sort(script.begin(), script.end(), [](const ScriptedCommand& a, const ScriptedCommand& b) {

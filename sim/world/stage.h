@@ -12,7 +12,8 @@ enum class Stage : uint8_t {
   Collision,        ///< body-body and body-terrain contacts                 (sim/collision)
   Response,         ///< gravity, contact impulses, projection, grass push   (sim/collision)
   Integrate,        ///< p += v dt; v += a dt; v *= damping^dt              (sim/particles)
-  Constraints,      ///< rod projection back to length L                     (sim/particles)
+                    ///< fused per row with Constraints (particle_row.h): its time is timed here
+  Constraints,      ///< rod projection back to length L; names a projection fault (never timed)
   PatchState,       ///< interpolation, tip offsets, tilt levels             (sim/patches)
   Count
 };

@@ -16,11 +16,13 @@ struct InputVec3 {
 };
 
 /// One command to one body, applied at the start of the tick (thesis keys T/F/G/H/U/J map to
-/// Displace or AddVelocity along the camera's axes; the viewer issue does that mapping).
+/// Displace or AddVelocity along the camera's axes; the viewer issue does that mapping). Bodies
+/// are numbered scenario bodies first, then spawned ones in spawn order; a command to a body that
+/// does not exist when it runs is ignored.
 struct BodyCommand {
   int32_t body = 0;
   BodyCommandKind kind = BodyCommandKind::AddVelocity;
-  InputVec3 value;  ///< m, m/s or N s depending on the kind
+  InputVec3 value;  ///< m, m/s or N s depending on the kind (Spawn: m; ignored by Reset, MowerOn, MowerOff)
   friend bool operator==(const BodyCommand&, const BodyCommand&) = default;
 };
 

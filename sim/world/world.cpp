@@ -3,11 +3,11 @@
 
 #include <bit>
 #include <cstring>
+#include <type_traits>
 
 #include "sim/bodies/integrate_bodies.h"
 #include "sim/collision/body_pairs.h"
-#include "sim/particles/integrate.h"
-#include "sim/particles/rod_constraint.h"
+#include "sim/particles/particle_row.h"
 #include "sim/world/state_sink.h"
 
 namespace sg {
@@ -19,6 +19,8 @@ namespace {
 constexpr char kStateMagic[8] = {'S', 'G', 'S', 'T', 'A', 'T', 'E', '1'};
 constexpr uint32_t kStateVersion = 1;
 constexpr size_t kStateHeaderBytes = 40;
+/// Opens the body-input block at the end of a state: spawned bodies and switched-off blades.
+constexpr char kBodyInputMagic[8] = {'S', 'G', 'B', 'O', 'D', 'Y', 'X', '1'};
 constexpr int64_t kTargetChunkElements = 4096;  // chunk size: fixed by problem size only
 
 template <class S>
@@ -154,6 +156,7 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
 
   patchConsts_.k = k;
   for (const Rational& w : c.interpolationWeights) patchConsts_.weight.push_back(toS<S>(w));
+  exactRowWeights_ = rowWeightsAreExact(patchConsts_);
   patchConsts_.rodLength = particleConsts_.rodLength;
   patchConsts_.halfRod = toS<S>(c.halfRod);
   patchConsts_.scaleY = toS<S>(f.scaleY);
@@ -186,6 +189,7 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   // Rigid bodies.
   for (size_t i = 0; i < s.bodies.list.size(); ++i)
     bodies_.push_back(makeBody<S>(s.bodies.list[i], s.timeStep, s.sourceName, "$.bodies.list[" + std::to_string(i) + "]"));
+  initialBodies_ = bodies_;
   gravityDt_ = Vec3<S>(toS<S>(s.bodies.gravity[0]), toS<S>(s.bodies.gravity[1]), toS<S>(s.bodies.gravity[2])) *
                particleConsts_.dt;
   solver_.velocityIterations = s.bodies.velocityIterations;
@@ -341,7 +345,7 @@ template <class S>
 void World<S>::setThreads(int threads) {
   if (threads < 1) threads = 1;
   if (threads != pool_->threads()) pool_ = std::make_unique<ChunkPool>(threads);
-  rowScratch_.assign(size_t(threads) * size_t(3 * grid_.countX), S(0));
+  rowScratch_.assign(size_t(threads) * size_t(3 * (grid_.countX + patchWindow_.sizeI)), S(0));
 }
 
 template <class S>
@@ -362,15 +366,20 @@ template <class S>
 template <class Fn>
 bool World<S>::runParticleRows(Stage stage, Fn&& rowKernel) {
   const int64_t chunks = (grid_.countZ + rowsPerChunk_ - 1) / rowsPerChunk_;
-  std::vector<int64_t> faultAt(size_t(chunks), -1);
+  std::vector<RowFault> faultAt(static_cast<size_t>(chunks));
   std::vector<uint32_t> faultBits(size_t(chunks), 0);
   pool_->run(chunks, [&](int64_t c, int) {
     takeFixedFaults();
     const int64_t b1 = std::min(grid_.countZ, (c + 1) * rowsPerChunk_);
     for (int64_t b = c * rowsPerChunk_; b < b1; ++b) {
-      const int64_t at = rowKernel(b, b * grid_.countX, (b + 1) * grid_.countX);
-      if (at >= 0) {
-        faultAt[size_t(c)] = at;
+      RowFault fault{-1, stage};
+      // A kernel returns the faulting particle (-1: none), or a RowFault when it spans stages.
+      if constexpr (std::is_same_v<decltype(rowKernel(b, b, b)), RowFault>)
+        fault = rowKernel(b, b * grid_.countX, (b + 1) * grid_.countX);
+      else
+        fault.particle = rowKernel(b, b * grid_.countX, (b + 1) * grid_.countX);
+      if (fault.particle >= 0) {
+        faultAt[size_t(c)] = fault;
         faultBits[size_t(c)] = takeFixedFaults();
         return;
       }
@@ -378,11 +387,11 @@ bool World<S>::runParticleRows(Stage stage, Fn&& rowKernel) {
   });
   // The first faulting chunk in index order: the same report for any thread count.
   for (int64_t c = 0; c < chunks; ++c) {
-    if (faultAt[size_t(c)] < 0) continue;
-    const int64_t q = faultAt[size_t(c)];
+    if (faultAt[size_t(c)].particle < 0) continue;
+    const int64_t q = faultAt[size_t(c)].particle;
     failed_ = true;
     failure_.tick = tick_;
-    failure_.stage = stage;
+    failure_.stage = faultAt[size_t(c)].stage;
     failure_.particle = q;
     failure_.latticeI = grid_.window.latticeColumn(q % grid_.countX) * grid_.k;
     failure_.latticeJ = grid_.window.latticeRow(q / grid_.countX) * grid_.k;
@@ -399,33 +408,57 @@ void World<S>::updatePatchState() {
     const int64_t b1 = std::min(grid_.countZ, (c + 1) * rowsPerChunk_);
     particleDisplacement(particles_, c * rowsPerChunk_ * grid_.countX, b1 * grid_.countX, rod, dispX_, dispY_, dispZ_);
   });
+  updatePatchesFromDisplacement();
+}
+
+template <class S>
+void World<S>::updatePatchesFromDisplacement() {
   if (grid_.k == 1) {  // patch and particle windows coincide: storage index for storage index
+    const PatchWriter<S> out(patches_, patchConsts_);
+    const S *dx = dispX_.data(), *dy = dispY_.data(), *dz = dispZ_.data();
     pool_->run((grid_.countZ + rowsPerChunk_ - 1) / rowsPerChunk_, [&](int64_t c, int) {
       const int64_t b1 = std::min(grid_.countZ, (c + 1) * rowsPerChunk_);
       for (int64_t q = c * rowsPerChunk_ * grid_.countX; q < b1 * grid_.countX; ++q)
-        writePatch(patches_, size_t(q), dispX_[size_t(q)], dispY_[size_t(q)], dispZ_[size_t(q)], patchConsts_);
+        out.write(size_t(q), dx[q], dy[q], dz[q]);
     });
     return;
   }
   const LatticeWindow& pw = patchWindow_;
   const int64_t patchRowsPerChunk = std::max<int64_t>(1, kTargetChunkElements / pw.sizeI);
   pool_->run((pw.sizeJ + patchRowsPerChunk - 1) / patchRowsPerChunk, [&](int64_t c, int worker) {
-    S* scratch = rowScratch_.data() + size_t(worker) * size_t(3 * grid_.countX);
+    S* scratch = rowScratch_.data() + size_t(worker) * size_t(3 * (grid_.countX + pw.sizeI));
     const int64_t j1 = pw.originJ + std::min(pw.sizeJ, (c + 1) * patchRowsPerChunk);
     for (int64_t j = pw.originJ + c * patchRowsPerChunk; j < j1; ++j)
-      updatePatchRow(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch);
+      exactRowWeights_ && grid_.k == 2 ? updatePatchRow<S, 2>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch)
+      : exactRowWeights_ && grid_.k == 4 ? updatePatchRow<S, 4>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch)
+                                          : updatePatchRow<S>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch);
   });
 }
+
+namespace {
+template <class S>
+Vec3<S> inputVector(const InputVec3& v) {
+  auto component = [](int64_t raw) { return ScalarTraits<S>::fromRational(Rational{raw, int64_t(1) << 32}).value_or(S(0)); };
+  return Vec3<S>(component(v.x), component(v.y), component(v.z));
+}
+}  // namespace
 
 template <class S>
 void World<S>::applyCommands(const TickInput& input) {
   for (const BodyCommand& cmd : input.bodies) {
     if (cmd.body < 0 || size_t(cmd.body) >= bodies_.size()) continue;  // validated by the reader
+    if (cmd.kind == BodyCommandKind::Spawn) {
+      spawnBody(cmd.body, cmd.value);
+      continue;
+    }
     RigidBody<S>& b = bodies_[size_t(cmd.body)];
+    // The blade switches touch only a mower's blade (not its sleep): anything else ignores them.
+    if (cmd.kind == BodyCommandKind::MowerOn || cmd.kind == BodyCommandKind::MowerOff) {
+      if (b.mower) b.bladeOn = cmd.kind == BodyCommandKind::MowerOn;
+      continue;
+    }
     wake(b);
-    const Vec3<S> v(ScalarTraits<S>::fromRational(Rational{cmd.value.x, int64_t(1) << 32}).value_or(S(0)),
-                    ScalarTraits<S>::fromRational(Rational{cmd.value.y, int64_t(1) << 32}).value_or(S(0)),
-                    ScalarTraits<S>::fromRational(Rational{cmd.value.z, int64_t(1) << 32}).value_or(S(0)));
+    const Vec3<S> v = inputVector<S>(cmd.value);
     switch (cmd.kind) {
       case BodyCommandKind::Displace: b.position += v; break;
       case BodyCommandKind::AddVelocity: b.velocity += v; break;
@@ -435,8 +468,62 @@ void World<S>::applyCommands(const TickInput& input) {
         b.velocity = Vec3<S>::Zero();
         b.angularVelocity = Vec3<S>::Zero();
         break;
+      case BodyCommandKind::Reset: resetBody(size_t(cmd.body)); break;
+      case BodyCommandKind::Spawn:
+      case BodyCommandKind::MowerOn:
+      case BodyCommandKind::MowerOff: break;  // handled above
     }
   }
+}
+
+template <class S>
+void World<S>::resetBody(size_t body) {
+  // The start pose: the scenario's for a scenario body, the spawn position and the template's
+  // orientation for a spawned one; at rest and awake either way (the scenario's initial
+  // velocity is not given again), its blade left as it is.
+  const size_t scenarioBodies = initialBodies_.size();
+  const RigidBody<S>& start = initialBodies_[size_t(bodyTemplate(int64_t(body)))];
+  RigidBody<S>& b = bodies_[body];
+  b.position = body < scenarioBodies ? start.position : inputVector<S>(spawns_[body - scenarioBodies].position);
+  b.orientation = start.orientation;
+  b.velocity = Vec3<S>::Zero();
+  b.angularVelocity = Vec3<S>::Zero();
+  b.stillTicks = 0;
+  b.asleep = false;
+  b.updateDerived();
+  dropCachedImpulses(body);
+}
+
+template <class S>
+void World<S>::spawnBody(int32_t templateBody, const InputVec3& at) {
+  // Beyond the cap the command is ignored (every replay ignores it the same way).
+  if (bodies_.size() >= size_t(kMaxBodies)) return;
+  Spawned spawned{bodyTemplate(templateBody), at};  // a spawned template stands for its own template
+  RigidBody<S> b = initialBodies_[size_t(spawned.templateBody)];
+  b.position = inputVector<S>(at);
+  b.velocity = Vec3<S>::Zero();
+  b.angularVelocity = Vec3<S>::Zero();
+  b.updateDerived();
+  bodies_.push_back(b);
+  spawns_.push_back(spawned);
+}
+
+template <class S>
+void World<S>::dropCachedImpulses(size_t body) {
+  const int32_t id = int32_t(body);
+  std::erase_if(impulseCache_, [id](const CachedImpulse<S>& c) { return c.bodyA == id || c.bodyB == id; });
+}
+
+template <class S>
+int32_t World<S>::bodyTemplate(int64_t body) const {
+  const int64_t scenarioBodies = int64_t(initialBodies_.size());
+  if (body < 0 || body >= int64_t(bodies_.size())) return -1;
+  return body < scenarioBodies ? int32_t(body) : spawns_[size_t(body - scenarioBodies)].templateBody;
+}
+
+template <class S>
+bool World<S>::bladeOn(int64_t body) const {
+  return body >= 0 && body < int64_t(bodies_.size()) && bodies_[size_t(body)].mower && bodies_[size_t(body)].bladeOn;
 }
 
 template <class S>
@@ -487,7 +574,7 @@ void World<S>::mowGrass() {
   // inside it. Cuts are keyed by lattice coordinates and never undone.
   const S invSpacing = S(1) / lattice_.spacing;
   for (const RigidBody<S>& body : bodies_) {
-    if (!body.mower) continue;
+    if (!body.mower || !body.bladeOn) continue;  // a switched-off blade still collides, but cuts nothing
     for (size_t part = 0; part < body.parts.size(); ++part) {
       const BodyPart<S>& shape = body.parts[part];
       const Pose<S> pose = body.partPose(part);
@@ -594,30 +681,26 @@ StepResult World<S>::step(const TickInput& input, StageObserver* observer) {
 
   const ParticleConstants<S>& c = particleConsts_;
   const bool pbd = constraintMode_ == ConstraintMode::Pbd;
+  // Integration, the rod constraint and the tip displacement run as one pass, row by row
+  // (sim/particles/particle_row.h): bit-identical to three passes, a third of the memory traffic.
+  // Its time is reported under Stage::Integrate; Stage::Constraints names a projection fault.
   begin(Stage::Integrate);
-  const bool integrated = runParticleRows(Stage::Integrate, [&](int64_t row, int64_t b, int64_t e) {
+  const bool moved = runParticleRows(Stage::Integrate, [&](int64_t row, int64_t b, int64_t e) {
     const size_t windRow = size_t(grid_.window.latticeRow(row));  // the wind acts per lattice row
     const S dvx = rowAccel_.x[windRow], dvy = rowAccel_.y[windRow], dvz = rowAccel_.z[windRow];
-    return pbd ? integrateParticleRow<S, true>(particles_, b, e, dvx, dvy, dvz, c)
-               : integrateParticleRow<S, false>(particles_, b, e, dvx, dvy, dvz, c);
+    return pbd ? advanceParticleRow<S, true>(particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_)
+               : advanceParticleRow<S, false>(particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_);
   });
-  if (integrated && hasBodies) {
+  if (moved && hasBodies) {
     integrateBodyPositions(bodies_, c.dt);
     updateSleep(bodies_, sleepLinear_, sleepAngular_, ticksToSleep_);
     if (bodiesFaulted(Stage::Integrate)) return {false, failure_};
   }
   end(Stage::Integrate);
-  if (!integrated) return {false, failure_};
-
-  begin(Stage::Constraints);
-  const bool projected = runParticleRows(Stage::Constraints, [&](int64_t, int64_t b, int64_t e) {
-    return pbd ? projectRodRow<S, true>(particles_, b, e, c) : projectRodRow<S, false>(particles_, b, e, c);
-  });
-  end(Stage::Constraints);
-  if (!projected) return {false, failure_};
+  if (!moved) return {false, failure_};
 
   begin(Stage::PatchState);
-  updatePatchState();
+  updatePatchesFromDisplacement();
   end(Stage::PatchState);
 
   ++tick_;
@@ -680,6 +763,26 @@ void World<S>::serialise(StateSink& sink) const {
     const int64_t origin[2] = {grid_.window.originI, grid_.window.originJ};
     sink.write(origin, sizeof origin);
   }
+  // Body inputs (only once a body was spawned or a blade switched off, so every other state is
+  // unchanged): magic, spawn count, per spawn (template, 0, position as Q32.32), then the count
+  // of switched-off blades and their bodies in increasing order. The spawned bodies' dynamic
+  // state is in the body blocks above (the header's body count includes them).
+  std::vector<int64_t> bladesOff;
+  for (size_t i = 0; i < bodies_.size(); ++i)
+    if (bodies_[i].mower && !bodies_[i].bladeOn) bladesOff.push_back(int64_t(i));
+  if (spawns_.empty() && bladesOff.empty()) return;
+  sink.write(kBodyInputMagic, sizeof kBodyInputMagic);
+  const uint64_t spawned = spawns_.size();
+  sink.write(&spawned, sizeof spawned);
+  for (const Spawned& sp : spawns_) {
+    const int32_t ids[2] = {sp.templateBody, 0};
+    const int64_t at[3] = {sp.position.x, sp.position.y, sp.position.z};
+    sink.write(ids, sizeof ids);
+    sink.write(at, sizeof at);
+  }
+  const uint64_t off = bladesOff.size();
+  sink.write(&off, sizeof off);
+  if (!bladesOff.empty()) sink.write(bladesOff.data(), bladesOff.size() * sizeof(int64_t));
 }
 
 template <class S>
@@ -698,10 +801,57 @@ std::vector<uint8_t> World<S>::saveState() const {
 }
 
 template <class S>
+void World<S>::readBodyInputBlock(std::span<const uint8_t> bytes, size_t at, size_t bodyCount,
+                                  std::vector<Spawned>* spawns, std::vector<uint8_t>* bladeOff) const {
+  const size_t scenarioBodies = initialBodies_.size();
+  auto need = [&](size_t from, size_t count, const std::string& what) {
+    if (bytes.size() - from < count) throw StateError(bytes.size(), what + " (the data ends early)");
+  };
+  need(at, 16, "the body-input block: magic 'SGBODYX1' and a spawn count");
+  if (std::memcmp(bytes.data() + at, kBodyInputMagic, 8) != 0)
+    throw StateError(at, std::to_string(at) + " bytes of state or the body-input magic 'SGBODYX1', got " +
+                             std::to_string(bytes.size()) + " bytes");
+  uint64_t spawned;
+  std::memcpy(&spawned, bytes.data() + at + 8, 8);
+  if (spawned != bodyCount - scenarioBodies)
+    throw StateError(at + 8, std::to_string(bodyCount - scenarioBodies) + " spawned bodies (the header's count), got " +
+                                 std::to_string(spawned));
+  size_t p = at + 16;
+  need(p, size_t(spawned) * 32 + 8, "spawned bodies and a switched-off blade count");
+  for (uint64_t i = 0; i < spawned; ++i, p += 32) {
+    int32_t ids[2];
+    int64_t xyz[3];
+    std::memcpy(ids, bytes.data() + p, 8);
+    std::memcpy(xyz, bytes.data() + p + 8, 24);
+    if (ids[0] < 0 || size_t(ids[0]) >= scenarioBodies || ids[1] != 0)
+      throw StateError(p, "a spawn template between 0 and " + std::to_string(scenarioBodies - 1) + ", then 0");
+    spawns->push_back(Spawned{ids[0], InputVec3{xyz[0], xyz[1], xyz[2]}});
+  }
+  uint64_t off;
+  std::memcpy(&off, bytes.data() + p, 8);
+  if (off > bodyCount) throw StateError(p, "at most " + std::to_string(bodyCount) + " switched-off blades, got " + std::to_string(off));
+  p += 8;
+  if (bytes.size() - p != size_t(off) * 8)
+    throw StateError(std::min(bytes.size(), p + size_t(off) * 8),
+                     std::to_string(p + size_t(off) * 8) + " bytes of state, got " + std::to_string(bytes.size()));
+  if (spawned == 0 && off == 0) throw StateError(at, "no body-input block when nothing was spawned or switched off");
+  int64_t previous = -1;
+  for (uint64_t i = 0; i < off; ++i, p += 8) {
+    int64_t body;
+    std::memcpy(&body, bytes.data() + p, 8);
+    if (body <= previous || body >= int64_t(bodyCount))
+      throw StateError(p, "switched-off blades in increasing body order, below " + std::to_string(bodyCount));
+    const size_t t = size_t(body) < scenarioBodies ? size_t(body) : size_t((*spawns)[size_t(body) - scenarioBodies].templateBody);
+    if (!initialBodies_[t].mower) throw StateError(p, "a mower's blade (body " + std::to_string(body) + " is no mower)");
+    (*bladeOff)[size_t(body)] = 1;
+    previous = body;
+  }
+}
+
+template <class S>
 void World<S>::restoreState(std::span<const uint8_t> bytes) {
   const size_t n = size_t(grid_.size());
-  const size_t bodyBytes = bodies_.size() * (13 * sizeof(S) + 8);
-  const size_t expectedSize = kStateHeaderBytes + 6 * n * sizeof(S) + bodyBytes + 8;  // minimum
+  const size_t scenarioBodies = initialBodies_.size();
   if (bytes.size() < kStateHeaderBytes) throw StateError(bytes.size(), "a 40-byte state header (the data ends early)");
   if (std::memcmp(bytes.data(), kStateMagic, 8) != 0) throw StateError(0, "the state magic 'SGSTATE1'");
   uint32_t version;
@@ -713,7 +863,13 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   if (bytes[13] != uint8_t(grid_.k)) throw StateError(13, "interpolation k = " + std::to_string(grid_.k));
   uint16_t bodyCount;
   std::memcpy(&bodyCount, bytes.data() + 14, 2);
-  if (bodyCount != bodies_.size()) throw StateError(14, std::to_string(bodies_.size()) + " bodies, got " + std::to_string(bodyCount));
+  // Spawns add bodies up to kMaxBodies (only to worlds that have a template body).
+  const size_t maxBodies = scenarioBodies == 0 ? 0 : std::max(scenarioBodies, size_t(kMaxBodies));
+  if (bodyCount < scenarioBodies || bodyCount > maxBodies)
+    throw StateError(14, (maxBodies == scenarioBodies ? std::to_string(scenarioBodies)
+                                                      : std::to_string(scenarioBodies) + " to " + std::to_string(maxBodies)) +
+                             " bodies, got " + std::to_string(bodyCount));
+  const size_t bodyBytes = size_t(bodyCount) * (13 * sizeof(S) + 8);
   uint64_t fingerprint;
   std::memcpy(&fingerprint, bytes.data() + 16, 8);
   if (fingerprint != configHash_) throw StateError(16, "a state saved from the same scenario (fingerprint differs)");
@@ -727,7 +883,7 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   const size_t entryBytes = 16 + 6 * sizeof(S);
   std::vector<CachedImpulse<S>> cache;
   size_t editsAt = cacheAt;
-  if (!bodies_.empty()) {
+  if (bodyCount > 0) {
     if (bytes.size() < cacheAt + 8) throw StateError(bytes.size(), "the contact-impulse count (the data ends early)");
     uint64_t cached;
     std::memcpy(&cached, bytes.data() + cacheAt, 8);
@@ -742,7 +898,7 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
       std::memcpy(ids, bytes.data() + at, 8);
       std::memcpy(features, bytes.data() + at + 8, 8);
       std::memcpy(impulses, bytes.data() + at + 16, sizeof impulses);
-      const int32_t nb = int32_t(bodies_.size());
+      const int32_t nb = int32_t(bodyCount);
       if (ids[0] < 0 || ids[0] >= nb || ids[1] < kTerrainBody || ids[1] >= nb)
         throw StateError(at, "contact bodies between -1 and " + std::to_string(nb - 1));
       c = CachedImpulse<S>{ids[0], ids[1], features[0], features[1], impulses[0], impulses[1], impulses[2],
@@ -759,10 +915,18 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   if (edits > uint64_t(lattice_.patchesX * lattice_.patchesZ))
     throw StateError(editsAt, "at most one edit per patch, got " + std::to_string(edits));
   const size_t windowAt = fixedSize + size_t(edits) * 16;
-  const size_t totalSize = windowAt + (lodWindow_ ? 16 : 0);
-  if (bytes.size() != totalSize)
-    throw StateError(std::min(bytes.size(), totalSize), std::to_string(totalSize) + " bytes of state, got " +
-                                                            std::to_string(bytes.size()));
+  const size_t blockAt = windowAt + (lodWindow_ ? 16 : 0);
+  // The body-input block follows when the bytes go on (only worlds with bodies have one).
+  const bool hasBlock = scenarioBodies > 0 && bytes.size() > blockAt;
+  if (!hasBlock && bytes.size() != blockAt)
+    throw StateError(std::min(bytes.size(), blockAt), std::to_string(blockAt) + " bytes of state, got " +
+                                                          std::to_string(bytes.size()));
+  std::vector<Spawned> spawns;
+  std::vector<uint8_t> bladeOff(bodyCount, 0);
+  if (hasBlock) readBodyInputBlock(bytes, blockAt, bodyCount, &spawns, &bladeOff);
+  else if (bodyCount != scenarioBodies)
+    throw StateError(blockAt, "the body-input block 'SGBODYX1' for " + std::to_string(bodyCount - scenarioBodies) +
+                                  " spawned bodies (the data ends early)");
   int64_t windowOrigin[2] = {0, 0};
   if (lodWindow_) {
     std::memcpy(windowOrigin, bytes.data() + windowAt, 16);
@@ -789,6 +953,11 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
     std::memcpy(v->data(), src, n * sizeof(S));
     src += n * sizeof(S);
   }
+  // Scenario bodies, then a copy of the template of each spawned one; the state over them.
+  bodies_.resize(scenarioBodies, initialBodies_.empty() ? RigidBody<S>{} : initialBodies_[0]);
+  for (const Spawned& sp : spawns) bodies_.push_back(initialBodies_[size_t(sp.templateBody)]);
+  spawns_ = std::move(spawns);
+  for (size_t i = 0; i < bodies_.size(); ++i) bodies_[i].bladeOn = bladeOff[i] == 0;
   for (RigidBody<S>& b : bodies_) {
     S v[13];
     std::memcpy(v, src, sizeof v);

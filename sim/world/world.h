@@ -100,6 +100,11 @@ class SimWorld {
   virtual void setThreads(int threads) = 0;
   /// Fills `out` (reusing its storage) with the current tips and body poses.
   virtual void observe(Observation& out) const = 0;
+  /// The scenario body (index into scenario.bodies.list) whose spec body `body` copies: its own
+  /// index for a scenario body, the Spawn command's template for a spawned one; -1 if no such body.
+  virtual int32_t bodyTemplate(int64_t body) const = 0;
+  /// Whether body `body` is a mower whose blade is on (MowerOn/MowerOff; mowers start on).
+  virtual bool bladeOn(int64_t body) const = 0;
 };
 
 /// Builds a world for scenario.scalar. Throws ScenarioError when the scenario does not fit it.
@@ -119,6 +124,8 @@ class World final : public SimWorld {
   void restoreState(std::span<const uint8_t> bytes) override;
   void setThreads(int threads) override;
   void observe(Observation& out) const override;
+  int32_t bodyTemplate(int64_t body) const override;
+  bool bladeOn(int64_t body) const override;
 
   // Read access for tests, tools and the renderer.
   const ParticleArrays<S>& particles() const { return particles_; }
@@ -140,12 +147,16 @@ class World final : public SimWorld {
   const std::map<std::pair<int64_t, int64_t>, uint8_t>& cuts() const { return cuts_; }
   const ParticleConstants<S>& particleConstants() const { return particleConsts_; }
   /// Recomputes the derived patch state from the particles (done by step and restore).
-  void updatePatchState();
+  void updatePatchState();               ///< tip displacement from the particles, then the patches
+  void updatePatchesFromDisplacement();  ///< the patches from dispX_/dispY_/dispZ_
 
  private:
   template <class Fn>
   bool runParticleRows(Stage stage, Fn&& rowKernel);
   void applyCommands(const TickInput& input);
+  void resetBody(size_t body);
+  void spawnBody(int32_t templateBody, const InputVec3& at);
+  void dropCachedImpulses(size_t body);
   void detectContacts();
   bool respondToContacts();
   bool bodiesFaulted(Stage stage);
@@ -177,6 +188,18 @@ class World final : public SimWorld {
   WindConstants<S> windConsts_;
   RowAccelerationDt<S> rowAccel_;
   std::vector<RigidBody<S>> bodies_;
+  /// Scenario bodies as built (Reset's start poses, Spawn's templates).
+  std::vector<RigidBody<S>> initialBodies_;
+  /// Spawned bodies (state): the template and the spawn position (Q32.32, Reset's start) of
+  /// each, in spawn order; body scenarioBodies + n is spawns_[n].
+  struct Spawned {
+    int32_t templateBody = 0;
+    InputVec3 position;
+  };
+  std::vector<Spawned> spawns_;
+  /// Parses the body-input block of a saved state at `at` (restoreState); throws StateError.
+  void readBodyInputBlock(std::span<const uint8_t> bytes, size_t at, size_t bodyCount, std::vector<Spawned>* spawns,
+                          std::vector<uint8_t>* bladeOff) const;
   /// Mown patches by lattice coordinates (i, j): persistent, ordered, saved and hashed.
   std::map<std::pair<int64_t, int64_t>, uint8_t> cuts_;
   S mowerCutHeight_{};
@@ -193,6 +216,7 @@ class World final : public SimWorld {
   std::vector<S> dispX_, dispY_, dispZ_;  ///< per-particle tip displacement (patch-state scratch)
   std::vector<S> rowScratch_;             ///< per-worker interpolation row
   int64_t rowsPerChunk_ = 1;
+  bool exactRowWeights_ = false;  ///< k = 2 or 4 with exact weights: the patch stage uses constant weights
   int64_t tick_ = 0;
   bool failed_ = false;
   SimError failure_;

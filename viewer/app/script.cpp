@@ -19,6 +19,9 @@ int scriptKeyCode(const std::string& name) {
   if (n == "shift") return GLFW_KEY_LEFT_SHIFT;
   if (n == "ctrl") return GLFW_KEY_LEFT_CONTROL;
   if (n == "escape") return GLFW_KEY_ESCAPE;
+  if (n == "backspace") return GLFW_KEY_BACKSPACE;
+  if (n == "period" || n == ".") return GLFW_KEY_PERIOD;
+  if (n == "home") return GLFW_KEY_HOME;
   return -1;
 }
 
@@ -70,7 +73,8 @@ bool parseScript(const std::string& text, const std::string& file, std::vector<S
     } else if (cmd == "key") {
       c.kind = ScriptCommand::Kind::Key;
       if (w.size() != 3 || (w[2] != "down" && w[2] != "up") || (c.key = scriptKeyCode(w[1])) < 0)
-        return fail("expected 'key K down|up' (K: a letter, a digit, tab, space, shift, ctrl or escape), got '" +
+        return fail("expected 'key K down|up' (K: a letter, a digit, tab, space, shift, ctrl, escape, backspace, "
+                    "period or home), got '" +
                     shown + "'");
       c.down = w[2] == "down";
     } else if (cmd == "camera") {
@@ -96,9 +100,51 @@ bool parseScript(const std::string& text, const std::string& file, std::vector<S
     } else if (cmd == "quit") {
       c.kind = ScriptCommand::Kind::Quit;
       if (w.size() != 1) return fail("expected 'quit', got '" + shown + "'");
+    } else if (cmd == "play" || cmd == "pause" || cmd == "regenerate" || cmd == "print") {
+      c.kind = cmd == "play" ? ScriptCommand::Kind::Play
+               : cmd == "pause" ? ScriptCommand::Kind::Pause
+               : cmd == "regenerate" ? ScriptCommand::Kind::Regenerate
+                                     : ScriptCommand::Kind::Print;
+      if (w.size() != 1) return fail("expected '" + cmd + "' alone, got '" + shown + "'");
+    } else if (cmd == "step") {
+      c.kind = ScriptCommand::Kind::Step;
+      if (w.size() != 2 || !parseCount(w[1], 100000000, &c.count))
+        return fail("expected 'step N' (N from 0 to 100000000), got '" + shown + "'");
+    } else if (cmd == "seek") {
+      c.kind = ScriptCommand::Kind::Seek;
+      if (w.size() != 2 || !parseCount(w[1], 1000000000000, &c.count))
+        return fail("expected 'seek T' (a tick >= 0), got '" + shown + "'");
+    } else if (cmd == "speed") {
+      c.kind = ScriptCommand::Kind::Speed;
+      float v = 0;
+      if (w.size() != 2 || !parseFloat(w[1], &v) || v < 0.25f || v > 8.0f)
+        return fail("expected 'speed X' (X from 0.25 to 8), got '" + shown + "'");
+      c.number = v;
+    } else if (cmd == "ab") {
+      c.kind = ScriptCommand::Kind::AbView;
+      if (w.size() != 2 || (w[1] != "side" && w[1] != "overlay"))
+        return fail("expected 'ab side' or 'ab overlay', got '" + shown + "'");
+      c.count = w[1] == "overlay";
+    } else if (cmd == "lod") {
+      c.kind = ScriptCommand::Kind::Lod;
+      if (w.size() != 2 || (w[1] != "on" && w[1] != "off")) return fail("expected 'lod on' or 'lod off', got '" + shown + "'");
+      c.count = w[1] == "on";
+    } else if (cmd == "open") {
+      c.kind = ScriptCommand::Kind::Open;
+      if (w.size() != 2) return fail("expected 'open PATH' (a scenario .json or a recording .sgr), got '" + shown + "'");
+      c.path = w[1];
+    } else if (cmd == "set") {
+      c.kind = ScriptCommand::Kind::Set;
+      if (w.size() < 3) return fail("expected 'set PATH VALUE' (e.g. 'set field.patchesX 41'), got '" + shown + "'");
+      c.path = w[1];
+      const size_t at = raw.find(w[1], raw.find("set") + 3) + w[1].size();
+      c.value = raw.substr(at);
+      c.value.erase(0, c.value.find_first_not_of(" \t"));
+      c.value.erase(c.value.find_last_not_of(" \t") + 1);
     } else {
       return fail("unknown command '" + shown +
-                  "' (expected frames, key, camera, select, record, screenshot or quit)");
+                  "' (expected frames, key, camera, select, record, screenshot, quit, play, pause, step, seek, "
+                  "speed, ab, open, set, regenerate, lod or print)");
     }
     out->push_back(c);
   }

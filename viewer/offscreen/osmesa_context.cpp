@@ -62,7 +62,7 @@ std::unique_ptr<OsmesaContext> OsmesaContext::create(std::string* error) {
   std::unique_ptr<OsmesaContext> c(new OsmesaContext());
   c->context_ = ctx;
   // The default framebuffer is never drawn to (the renderer uses its own FBOs): keep it tiny.
-  constexpr int kSide = 4;
+  constexpr int kSide = 4;  // (makeCurrent() uses the same size)
   c->buffer_ = std::make_unique<unsigned char[]>(kSide * kSide * 4);
   if (!OSMesaMakeCurrent(ctx, c->buffer_.get(), GL_UNSIGNED_BYTE, kSide, kSide)) {
     if (error) *error = "OSMesa: OSMesaMakeCurrent failed";
@@ -97,6 +97,11 @@ OsmesaContext::~OsmesaContext() {
 
 std::string OsmesaContext::describe() const { return glDescription(); }
 
+void OsmesaContext::makeCurrent() {
+  if (OSMesaGetCurrentContext() != static_cast<OSMesaContext>(context_))
+    OSMesaMakeCurrent(static_cast<OSMesaContext>(context_), buffer_.get(), GL_UNSIGNED_BYTE, 4, 4);
+}
+
 // ---- OffscreenRenderer -----------------------------------------------------------------------
 
 std::unique_ptr<OffscreenRenderer> OffscreenRenderer::create(int width, int height, int msaa, std::string* error) {
@@ -117,8 +122,13 @@ std::unique_ptr<OffscreenRenderer> OffscreenRenderer::create(int width, int heig
   return r;
 }
 
+OffscreenRenderer::OffscreenRenderer() = default;
+
+Renderer& OffscreenRenderer::renderer() { return *renderer_; }
+
 OffscreenRenderer::~OffscreenRenderer() {
-  // GL objects go first, while the context is still current.
+  // GL objects go first, while the context is current (another renderer may have taken it).
+  if (context_) context_->makeCurrent();
   scene_.reset();
   target_.reset();
   renderer_.reset();
@@ -134,8 +144,11 @@ Image OffscreenRenderer::render(const Scene& scene, const Camera& camera) { retu
 
 Image OffscreenRenderer::render(const Scene& scene, const Camera& camera, double* renderMs) {
   const auto start = std::chrono::steady_clock::now();
+  context_->makeCurrent();  // several offscreen renderers may live in one program (tests)
   target_->bind();
-  renderer_->draw(scene, camera, width_, height_, samples_ > 0);
+  RenderOptions options = options_;
+  options.alphaToCoverage = options_.alphaToCoverage && samples_ > 0;  // needs the MSAA target
+  renderer_->draw(scene, camera, width_, height_, options);
   Image image = target_->read();  // glReadPixels waits for the frame
   if (renderMs) *renderMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return image;

@@ -14,6 +14,7 @@
 
 #include "viewer/render/atlas.h"
 #include "viewer/render/camera.h"
+#include "viewer/render/renderer.h"
 
 namespace sg {
 class SimWorld;
@@ -38,6 +39,8 @@ class OsmesaContext {
   /// GL_RENDERER and GL_VERSION, e.g. "llvmpipe (LLVM 15.0.6, 256 bits), 4.5 (Core Profile) Mesa 22.3.6".
   std::string describe() const;
   int maxSamples() const { return maxSamples_; }
+  /// Makes this context current on the calling thread (a no-op when it is).
+  void makeCurrent();
 
  private:
   OsmesaContext() = default;
@@ -62,18 +65,24 @@ class OffscreenRenderer {
   Image render(const Scene& scene, const Camera& camera, double* renderMs);
 
   Scene& scene() { return *scene_; }  ///< the scene render(world, ...) extracts into (reused)
+  /// What render() draws (SSAO, rock, heat map, debug overlay). alphaToCoverage applies only with
+  /// samples() > 0 (false: alpha test even on the multisampled target). Defaults: the goldens.
+  RenderOptions& options() { return options_; }
+  Renderer& renderer();  ///< e.g. setAssetDirectory(), lastAssetError(), readAmbientOcclusion()
   const OsmesaContext& context() const { return *context_; }
+  OsmesaContext& context() { return *context_; }
   int width() const { return width_; }
   int height() const { return height_; }
   int samples() const { return samples_; }
 
  private:
-  OffscreenRenderer() = default;
+  OffscreenRenderer();
   int width_ = 0, height_ = 0, samples_ = 0;
   std::unique_ptr<OsmesaContext> context_;
   std::unique_ptr<Renderer> renderer_;
   std::unique_ptr<RenderTarget> target_;
   std::unique_ptr<Scene> scene_;
+  RenderOptions options_;
 };
 
 }  // namespace sg::viewer

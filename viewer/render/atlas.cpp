@@ -431,6 +431,32 @@ Image makeGroundTexture(const TuftAtlas& atlas, uint64_t seed, int size) {
   return img;
 }
 
+Image makeRockTexture(uint64_t seed, int size) {
+  if (size < 4 || size > 8192 || (size & (size - 1)) != 0)
+    throw std::invalid_argument("makeRockTexture: size must be a power of two in 4..8192, got " + std::to_string(size));
+  const Rgb light = fromSrgb(0.56f, 0.54f, 0.50f), dark = fromSrgb(0.36f, 0.34f, 0.31f);
+  const Rgb lichen = fromSrgb(0.50f, 0.50f, 0.36f);
+  const uint64_t seedTone = hashOf(seed, 0x524F434Bull /* "ROCK" */, 1), seedCrack = hashOf(seed, 0x524F434Bull, 2),
+                 seedLichen = hashOf(seed, 0x524F434Bull, 3), seedGrain = hashOf(seed, 0x524F434Bull, 4);
+  Image img;
+  img.width = img.height = size;
+  img.rgba.assign(size_t(size) * size_t(size) * 4, 255);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      // Broad tone variation, then cracks where a second noise crosses its median (ridged: dark
+      // thin lines), lichen blotches and a fine grain. Every noise wraps, so the texture tiles.
+      const float tone = stretch(tilingFbm(seedTone, x, y, size / 4, size), 1.8f);
+      Rgb c = lerp(dark, light, tone);
+      const float ridge = std::fabs(tilingFbm(seedCrack, x, y, size / 8, size) - 0.5f);
+      c = c * (0.55f + 0.45f * smooth(std::clamp(ridge / 0.025f, 0.0f, 1.0f)));
+      const float l = std::clamp((tilingFbm(seedLichen, x, y, size / 8, size) - 0.6f) / 0.1f, 0.0f, 1.0f);
+      c = lerp(c, lichen * (luminance(c) / luminance(lichen)), 0.6f * smooth(l));
+      const float grain = tilingNoise(seedGrain, x, y, 4, size);
+      storeTexel(img.at(x, y), c * (0.88f + 0.24f * grain), 1.0f);
+    }
+  return img;
+}
+
 // ---- PNG -----------------------------------------------------------------------------------
 
 bool writePng(const std::string& path, const Image& image, std::string* error) {

@@ -66,6 +66,11 @@ inline constexpr float kGroundDarkening = 0.5f;
 /// Opaque. Throws std::invalid_argument if size is not a power of two in 4..8192.
 Image makeGroundTexture(const TuftAtlas& atlas, uint64_t seed, int size = 256);
 
+/// A seamlessly tiling rock texture (`size` x `size`, power of two; grey-brown stone with cracks,
+/// lichen and grain), deterministic in `seed`: the ground shader blends to it on steep slopes.
+/// Opaque. Throws std::invalid_argument if size is not a power of two in 4..8192.
+Image makeRockTexture(uint64_t seed, int size = 256);
+
 /// Writes a PNG (stb_image_write). Returns false with *error = "path: why" on failure.
 bool writePng(const std::string& path, const Image& image, std::string* error);
 

@@ -5,9 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <map>
 #include <stdexcept>
 #include <vector>
 
+#include "viewer/render/obj_mesh.h"
 #include "viewer/render/shaders.h"
 
 namespace sg::viewer {
@@ -193,6 +196,48 @@ GLuint uploadTexture(const Image& image, bool repeat) {
   return t;
 }
 
+/// A single-sampled texture to render into: nearest filtering, clamped (read by texelFetch or
+/// at matching resolution).
+GLuint renderTexture(GLenum internalFormat, GLenum format, GLenum type, int width, int height) {
+  GLuint t = 0;
+  glGenTextures(1, &t);
+  glBindTexture(GL_TEXTURE_2D, t);
+  glTexImage2D(GL_TEXTURE_2D, 0, GLint(internalFormat), width, height, 0, format, type, nullptr);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return t;
+}
+
+GLuint framebufferOf(GLuint colour, GLuint depth) {
+  GLuint f = 0;
+  glGenFramebuffers(1, &f);
+  glBindFramebuffer(GL_FRAMEBUFFER, f);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, colour, 0);
+  if (depth) glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, depth, 0);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    glDeleteFramebuffers(1, &f);
+    throw std::runtime_error("renderer: the SSAO framebuffer is incomplete");
+  }
+  return f;
+}
+
+/// SSAO sample kernel: 16 points in the unit hemisphere around +z, on a golden-angle spiral
+/// (evenly spread directions), lengths growing quadratically from 0.1 so most samples test the
+/// near neighbourhood. Fixed (no random numbers): the same image on every run.
+std::vector<float> ssaoKernel() {
+  std::vector<float> k;
+  constexpr int n = 16;
+  for (int i = 0; i < n; ++i) {
+    const float z = 1.0f - (float(i) + 0.5f) / float(n);  // cos of the angle from the normal
+    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z)), phi = 2.39996323f * float(i);
+    const float f = float(i + 1) / float(n), length = 0.1f + 0.9f * f * f;
+    k.insert(k.end(), {r * std::cos(phi) * length, r * std::sin(phi) * length, std::max(z, 0.15f) * length});
+  }
+  return k;
+}
+
 }  // namespace
 
 // ---- RenderTarget ----------------------------------------------------------------------------
@@ -277,24 +322,40 @@ Image RenderTarget::read() {
 
 struct Renderer::Impl {
   GLuint tuftProgram = 0, groundProgram = 0, bodyProgram = 0, skyProgram = 0;
-  GLuint tuftVao = 0, tuftBuffer = 0, emptyVao = 0;
+  GLuint prepassGround = 0, prepassBody = 0, prepassTuft = 0, ssaoProgram = 0, blurProgram = 0, debugProgram = 0;
+  GLuint tuftVao = 0, tuftBuffer = 0, emptyVao = 0, debugVao = 0, debugBuffer = 0;
   size_t tuftCapacity = 0;
   Mesh sphere, cube, ground;
   uint64_t groundRevision = 0;
-  GLuint atlasTexture = 0, groundTexture = 0;
+  GLuint atlasTexture = 0, groundTexture = 0, rockTexture = 0;
+  // SSAO targets (created for the viewport size on first use).
+  int ssaoWidth = 0, ssaoHeight = 0;
+  GLuint prepassFbo = 0, prepassNormal = 0, prepassDepth = 0;
+  GLuint aoFbo[2] = {0, 0}, aoTexture[2] = {0, 0};  ///< raw, blurred (half resolution)
+  bool aoValid = false;                             ///< the last frame computed SSAO
+  std::vector<float> kernel = ssaoKernel();
+  /// Meshes by resolved path; a failed load keeps its error (no retry every frame).
+  struct LoadedMesh {
+    Mesh mesh;
+    std::string error;
+  };
+  std::map<std::string, LoadedMesh> meshes;
   std::unique_ptr<TuftAtlas> atlas;
   std::vector<TuftInstance> sorted;         ///< tufts front to back (scratch)
   std::vector<std::pair<float, uint32_t>> order;
   int atlasVariants = -1;
   uint64_t atlasSeed = 0;
+  std::string assetDirectory, lastAssetError;
 
   void ensureAtlas(int variants, uint64_t seed) {
     if (atlas && variants == atlasVariants && seed == atlasSeed) return;
     if (atlasTexture) glDeleteTextures(1, &atlasTexture);
     if (groundTexture) glDeleteTextures(1, &groundTexture);
     atlas = std::make_unique<TuftAtlas>(makeTuftAtlas(variants, seed));
+    if (rockTexture) glDeleteTextures(1, &rockTexture);
     atlasTexture = uploadTexture(atlas->image, false);
     groundTexture = uploadTexture(makeGroundTexture(*atlas, seed), true);
+    rockTexture = uploadTexture(makeRockTexture(seed), true);
     atlasVariants = variants;
     atlasSeed = seed;
   }
@@ -326,16 +387,74 @@ struct Renderer::Impl {
     groundRevision = g.revision;
   }
 
+  /// The mesh for `path` (resolved against `directory`), loading it on first use; null with
+  /// *error set when it does not load.
+  const Mesh* meshFor(const std::string& path, const std::string& directory, std::string* error) {
+    std::filesystem::path resolved(path);
+    if (resolved.is_relative() && !directory.empty()) resolved = std::filesystem::path(directory) / resolved;
+    const std::string key = resolved.lexically_normal().string();
+    auto it = meshes.find(key);
+    if (it == meshes.end()) {
+      LoadedMesh& m = meshes[key];
+      ObjMesh obj;
+      if (loadObjMesh(key, &obj, &m.error)) {
+        std::vector<float> v;
+        v.reserve(obj.positions.size() * 2);
+        for (size_t i = 0; i < obj.positions.size(); i += 3)
+          v.insert(v.end(), {obj.positions[i], obj.positions[i + 1], obj.positions[i + 2], obj.normals[i],
+                             obj.normals[i + 1], obj.normals[i + 2]});
+        m.mesh.upload(v, obj.indices);
+      }
+      it = meshes.find(key);
+    }
+    if (!it->second.error.empty()) {
+      *error = it->second.error;
+      return nullptr;
+    }
+    return &it->second.mesh;
+  }
+
+  void ensureSsaoTargets(int width, int height) {
+    if (prepassFbo && width == ssaoWidth && height == ssaoHeight) return;
+    releaseSsaoTargets();
+    ssaoWidth = width;
+    ssaoHeight = height;
+    prepassNormal = renderTexture(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, width, height);
+    prepassDepth = renderTexture(GL_DEPTH_COMPONENT24, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, width, height);
+    prepassFbo = framebufferOf(prepassNormal, prepassDepth);
+    const int hw = std::max(1, width / 2), hh = std::max(1, height / 2);
+    for (int i = 0; i < 2; ++i) {
+      aoTexture[i] = renderTexture(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, hw, hh);
+      aoFbo[i] = framebufferOf(aoTexture[i], 0);
+    }
+    // The blurred AO is read at full resolution: filter it.
+    glBindTexture(GL_TEXTURE_2D, aoTexture[1]);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  }
+
+  void releaseSsaoTargets() {
+    for (GLuint* f : {&prepassFbo, &aoFbo[0], &aoFbo[1]})
+      if (*f) glDeleteFramebuffers(1, f), *f = 0;
+    for (GLuint* t : {&prepassNormal, &prepassDepth, &aoTexture[0], &aoTexture[1]})
+      if (*t) glDeleteTextures(1, t), *t = 0;
+    aoValid = false;
+  }
+
   ~Impl() {
-    for (GLuint p : {tuftProgram, groundProgram, bodyProgram, skyProgram})
+    for (GLuint p : {tuftProgram, groundProgram, bodyProgram, skyProgram, prepassGround, prepassBody, prepassTuft,
+                     ssaoProgram, blurProgram, debugProgram})
       if (p) glDeleteProgram(p);
-    if (tuftBuffer) glDeleteBuffers(1, &tuftBuffer);
-    for (GLuint* a : {&tuftVao, &emptyVao})
+    for (GLuint* b : {&tuftBuffer, &debugBuffer})
+      if (*b) glDeleteBuffers(1, b);
+    for (GLuint* a : {&tuftVao, &emptyVao, &debugVao})
       if (*a) glDeleteVertexArrays(1, a);
     sphere.release();
     cube.release();
     ground.release();
-    for (GLuint* t : {&atlasTexture, &groundTexture})
+    for (auto& [path, m] : meshes) m.mesh.release();
+    releaseSsaoTargets();
+    for (GLuint* t : {&atlasTexture, &groundTexture, &rockTexture})
       if (*t) glDeleteTextures(1, t);
   }
 };
@@ -346,6 +465,21 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
   r.groundProgram = link(shaders::kGroundVertex, litFragment(shaders::kGroundFragment), "ground");
   r.bodyProgram = link(shaders::kBodyVertex, litFragment(shaders::kBodyFragment), "body");
   r.skyProgram = link(shaders::kSkyVertex, shaders::kSkyFragment, "sky");
+  r.prepassGround = link(shaders::kGroundVertex, shaders::kPrepassSolidFragment, "prepass ground");
+  r.prepassBody = link(shaders::kBodyVertex, shaders::kPrepassSolidFragment, "prepass body");
+  r.prepassTuft = link(shaders::kTuftVertex, shaders::kPrepassTuftFragment, "prepass tuft");
+  r.ssaoProgram = link(shaders::kFullscreenVertex, shaders::kSsaoFragment, "ssao");
+  r.blurProgram = link(shaders::kFullscreenVertex, shaders::kBlurFragment, "ssao blur");
+  r.debugProgram = link(shaders::kDebugVertex, shaders::kDebugFragment, "debug");
+  glGenVertexArrays(1, &r.debugVao);
+  glGenBuffers(1, &r.debugBuffer);
+  glBindVertexArray(r.debugVao);
+  glBindBuffer(GL_ARRAY_BUFFER, r.debugBuffer);
+  for (GLuint a = 0; a < 3; ++a) {  // position, colour, point size: 7 floats a vertex
+    glEnableVertexAttribArray(a);
+    glVertexAttribPointer(a, a == 2 ? 1 : 3, GL_FLOAT, GL_FALSE, 7 * sizeof(float),
+                          reinterpret_cast<const void*>(size_t(a) * 3 * sizeof(float)));
+  }
   glGenVertexArrays(1, &r.emptyVao);
   glGenVertexArrays(1, &r.tuftVao);
   glGenBuffers(1, &r.tuftBuffer);
@@ -360,7 +494,7 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
   glVertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<const void*>(offsetof(TuftInstance, topY)));
   glVertexAttribDivisor(1, 1);
   glEnableVertexAttribArray(2);
-  glVertexAttribPointer(2, 2, GL_UNSIGNED_BYTE, GL_FALSE, stride,
+  glVertexAttribPointer(2, 3, GL_UNSIGNED_BYTE, GL_FALSE, stride,  // variant, level, heat
                         reinterpret_cast<const void*>(offsetof(TuftInstance, variant)));
   glVertexAttribDivisor(2, 1);
   glBindVertexArray(0);
@@ -373,105 +507,79 @@ Renderer::~Renderer() = default;
 const TuftAtlas* Renderer::atlas() const { return impl_->atlas.get(); }
 
 void Renderer::draw(const Scene& scene, const Camera& camera, int width, int height, bool alphaToCoverage) {
+  RenderOptions options;
+  options.alphaToCoverage = alphaToCoverage;
+  draw(scene, camera, width, height, options);
+}
+
+void Renderer::setAssetDirectory(const std::string& directory) { impl_->assetDirectory = directory; }
+
+const std::string& Renderer::lastAssetError() const { return impl_->lastAssetError; }
+
+Image Renderer::readAmbientOcclusion() {
   Impl& r = *impl_;
+  Image img;
+  if (!r.aoValid) return img;
+  GLint previous = 0;
+  glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &previous);
+  img.width = std::max(1, r.ssaoWidth / 2);
+  img.height = std::max(1, r.ssaoHeight / 2);
+  std::vector<uint8_t> raw(size_t(img.width) * size_t(img.height) * 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, r.aoFbo[1]);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, img.width, img.height, GL_RGBA, GL_UNSIGNED_BYTE, raw.data());
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, GLuint(previous));
+  img.rgba.resize(raw.size());
+  const size_t row = size_t(img.width) * 4;  // GL's row 0 is the bottom
+  for (int y = 0; y < img.height; ++y)
+    std::memcpy(img.rgba.data() + size_t(y) * row, raw.data() + size_t(img.height - 1 - y) * row, row);
+  return img;
+}
+
+void Renderer::draw(const Scene& scene, const Camera& camera, int width, int height, const RenderOptions& options) {
+  Impl& r = *impl_;
+  const bool alphaToCoverage = options.alphaToCoverage;
   const Lighting& L = lighting_;
   r.ensureAtlas(std::clamp(scene.atlasVariants, 1, 16), scene.atlasSeed);
   if (r.groundRevision != scene.ground.revision) r.uploadGround(scene.ground);
 
   const float aspect = float(width) / float(std::max(height, 1));
-  const Mat4 viewProj = multiply(camera.projection(aspect), camera.view());
+  const Mat4 view = camera.view(), projection = camera.projection(aspect);
+  const Mat4 viewProj = multiply(projection, view);
   std::array<float, 3> sun = L.sunDirection;
   const float sl = std::sqrt(sun[0] * sun[0] + sun[1] * sun[1] + sun[2] * sun[2]);
   for (float& c : sun) c /= sl;
 
-  glViewport(0, 0, width, height);
-  glClearColor(L.horizon[0], L.horizon[1], L.horizon[2], 1);
-  glClearDepth(1.0);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_BLEND);
-
-  // 1. Sky, behind everything (no depth test, no depth writes).
-  glDisable(GL_DEPTH_TEST);
-  glDepthMask(GL_FALSE);
-  glUseProgram(r.skyProgram);
-  setMat(r.skyProgram, "uInvViewProj", inverse4(viewProj));
-  set3(r.skyProgram, "uCameraPos", camera.x, camera.y, camera.z);
-  set3(r.skyProgram, "uSunDir", sun);
-  set3(r.skyProgram, "uZenith", L.zenith);
-  set3(r.skyProgram, "uHorizon", L.horizon);
-  glBindVertexArray(r.emptyVao);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
-  glEnable(GL_DEPTH_TEST);
-  glDepthMask(GL_TRUE);
-  glDepthFunc(GL_LESS);
-
-  // Body shadow discs (shared by the ground and the tufts).
-  std::vector<float> shadows;
-  for (const BodyPartDraw& b : scene.bodyParts) {
-    if (shadows.size() / 4 >= size_t(kMaxShadows)) break;
-    const Mat4& m = b.model;
-    const float ex = std::fabs(m[0]) + std::fabs(m[4]) + std::fabs(m[8]);
-    const float ey = std::fabs(m[1]) + std::fabs(m[5]) + std::fabs(m[9]);
-    const float ez = std::fabs(m[2]) + std::fabs(m[6]) + std::fabs(m[10]);
-    const float radius = b.shape == BodyPartDraw::Shape::Sphere ? ey : 0.5f * (ex + ez);
-    shadows.insert(shadows.end(), {m[12], m[14], radius, m[13] - ey});
-  }
-  auto common = [&](GLuint p) {
-    glUseProgram(p);
-    setMat(p, "uViewProj", viewProj);
-    set3(p, "uCameraPos", camera.x, camera.y, camera.z);
-    set3(p, "uSunDir", sun);
-    set3(p, "uSunColour", L.sunColour);
-    set3(p, "uAmbient", L.ambient);
-    set3(p, "uFogColour", L.horizon);
-    glUniform1f(loc(p, "uFogDensity"), L.fogDensity);
-    glUniform1i(loc(p, "uShadowCount"), GLint(shadows.size() / 4));
-    if (!shadows.empty()) glUniform4fv(loc(p, "uShadows"), GLsizei(shadows.size() / 4), shadows.data());
+  // What each body draws: a loaded mesh, else its primitives (a mesh that fails to load falls
+  // back to the collision proxies, with the error recorded).
+  struct Draw {
+    const BodyPartDraw* part;
+    const Mesh* mesh;
   };
-
-  // 2. Ground.
-  if (r.ground.indices > 0) {
-    common(r.groundProgram);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, r.groundTexture);
-    glUniform1i(loc(r.groundProgram, "uGround"), 0);
-    glUniform1f(loc(r.groundProgram, "uGroundTile"), L.groundTileMetres);
-    glUniform1f(loc(r.groundProgram, "uGroundShade"), L.groundShade);
-    r.ground.draw();
-  }
-
-  // 3. Bodies.
-  if (!scene.bodyParts.empty()) {
-    common(r.bodyProgram);
-    for (const BodyPartDraw& b : scene.bodyParts) {
-      setMat(r.bodyProgram, "uModel", b.model);
-      set3(r.bodyProgram, "uAlbedo", b.colour[0], b.colour[1], b.colour[2]);
-      glUniform1i(loc(r.bodyProgram, "uFootball"), b.pattern == BodyPartDraw::Pattern::Football ? 1 : 0);
-      (b.shape == BodyPartDraw::Shape::Sphere ? r.sphere : r.cube).draw();
+  std::vector<Draw> draws;
+  std::vector<const BodyPartDraw*> primitives;  // for the shadow discs
+  r.lastAssetError.clear();
+  for (const BodyPartDraw& b : scene.bodyParts) {
+    if (b.shape != BodyPartDraw::Shape::Mesh) {
+      draws.push_back({&b, b.shape == BodyPartDraw::Shape::Sphere ? &r.sphere : &r.cube});
+      primitives.push_back(&b);
+      continue;
+    }
+    std::string error;
+    const Mesh* mesh = r.meshFor(b.mesh, r.assetDirectory, &error);
+    if (mesh) draws.push_back({&b, mesh});
+    else r.lastAssetError = error;
+    for (uint32_t i = b.firstProxy; i < b.firstProxy + b.proxyCount && i < scene.meshProxies.size(); ++i) {
+      const BodyPartDraw& proxy = scene.meshProxies[i];
+      if (!mesh) draws.push_back({&proxy, proxy.shape == BodyPartDraw::Shape::Sphere ? &r.sphere : &r.cube});
+      primitives.push_back(&proxy);
     }
   }
 
-  // 4. Tufts.
-  if (!scene.tufts.empty()) {
-    common(r.tuftProgram);
-    std::vector<float> tiles;
-    const TuftAtlas& atlas = *r.atlas;
-    for (int v = 0; v <= atlas.variants; ++v)
-      for (int l = 0; l < atlas.levels; ++l) {
-        const TuftAtlas::Rect t = atlas.tile(v, l);
-        tiles.insert(tiles.end(), {t.u0, t.v0, t.u1, t.v1});
-      }
-    glUniform4fv(loc(r.tuftProgram, "uTiles"), GLsizei(std::min<size_t>(tiles.size() / 4, kMaxTiles)), tiles.data());
-    glUniform1i(loc(r.tuftProgram, "uLevels"), atlas.levels);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, r.atlasTexture);
-    glUniform1i(loc(r.tuftProgram, "uAtlas"), 0);
-    glUniform2f(loc(r.tuftProgram, "uAtlasSize"), float(atlas.image.width), float(atlas.image.height));
-    glUniform1i(loc(r.tuftProgram, "uAlphaToCoverage"), alphaToCoverage ? 1 : 0);
-    // Front to back: the depth test then rejects most hidden tuft fragments before shading
-    // (a software rasteriser pays for every shaded fragment).
-    const size_t n = scene.tufts.size();
+  // Tufts front to back: the depth test then rejects most hidden tuft fragments before shading
+  // (a software rasteriser pays for every shaded fragment). Uploaded once for both passes.
+  const size_t n = scene.tufts.size();
+  if (n > 0) {
     r.order.resize(n);
     for (size_t i = 0; i < n; ++i) {
       const TuftInstance& t = scene.tufts[i];
@@ -490,10 +598,207 @@ void Renderer::draw(const Scene& scene, const Camera& camera, int width, int hei
     } else {
       glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(bytes), r.sorted.data());
     }
+  }
+  std::vector<float> tiles;
+  const TuftAtlas& atlas = *r.atlas;
+  for (int v = 0; v <= atlas.variants; ++v)
+    for (int l = 0; l < atlas.levels; ++l) {
+      const TuftAtlas::Rect t = atlas.tile(v, l);
+      tiles.insert(tiles.end(), {t.u0, t.v0, t.u1, t.v1});
+    }
+  auto tuftUniforms = [&](GLuint p) {
+    glUniform4fv(loc(p, "uTiles"), GLsizei(std::min<size_t>(tiles.size() / 4, kMaxTiles)), tiles.data());
+    glUniform1i(loc(p, "uLevels"), atlas.levels);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, r.atlasTexture);
+    glUniform1i(loc(p, "uAtlas"), 0);
+    glUniform2f(loc(p, "uAtlasSize"), float(atlas.image.width), float(atlas.image.height));
+  };
+
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  r.aoValid = false;
+  if (options.ssao && width > 0 && height > 0) {
+    // SSAO: prepass (normals + depth), occlusion at half resolution, blur; then back to the
+    // host's framebuffer and viewport.
+    GLint hostFbo = 0;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &hostFbo);
+    r.ensureSsaoTargets(width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, r.prepassFbo);
+    glViewport(0, 0, width, height);
+    glClearColor(0.5f, 0.5f, 1.0f, 1.0f);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    auto prepass = [&](GLuint p) {
+      glUseProgram(p);
+      setMat(p, "uViewProj", viewProj);
+      setMat(p, "uView", view);
+      set3(p, "uCameraPos", camera.x, camera.y, camera.z);
+    };
+    if (r.ground.indices > 0) {
+      prepass(r.prepassGround);
+      r.ground.draw();
+    }
+    if (!draws.empty()) {
+      prepass(r.prepassBody);
+      for (const Draw& d : draws) {
+        setMat(r.prepassBody, "uModel", d.part->model);
+        d.mesh->draw();
+      }
+    }
+    if (n > 0) {
+      prepass(r.prepassTuft);
+      tuftUniforms(r.prepassTuft);
+      glBindVertexArray(r.tuftVao);
+      glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(n));
+    }
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    glViewport(0, 0, std::max(1, width / 2), std::max(1, height / 2));
+    glBindFramebuffer(GL_FRAMEBUFFER, r.aoFbo[0]);
+    glUseProgram(r.ssaoProgram);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, r.prepassDepth);
+    glUniform1i(loc(r.ssaoProgram, "uDepth"), 0);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, r.prepassNormal);
+    glUniform1i(loc(r.ssaoProgram, "uNormal"), 1);
+    setMat(r.ssaoProgram, "uProj", projection);
+    setMat(r.ssaoProgram, "uInvProj", inverse4(projection));
+    glUniform3fv(loc(r.ssaoProgram, "uKernel"), GLsizei(r.kernel.size() / 3), r.kernel.data());
+    glUniform1f(loc(r.ssaoProgram, "uRadius"), L.ssaoRadius);
+    glUniform1f(loc(r.ssaoProgram, "uStrength"), L.ssaoStrength);
+    glBindVertexArray(r.emptyVao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindFramebuffer(GL_FRAMEBUFFER, r.aoFbo[1]);
+    glUseProgram(r.blurProgram);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, r.aoTexture[0]);
+    glUniform1i(loc(r.blurProgram, "uSource"), 0);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindFramebuffer(GL_FRAMEBUFFER, GLuint(hostFbo));
+    r.aoValid = true;
+  }
+
+  glViewport(0, 0, width, height);
+  glClearColor(L.horizon[0], L.horizon[1], L.horizon[2], 1);
+  glClearDepth(1.0);
+  glDepthMask(GL_TRUE);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+
+  // 1. Sky, behind everything (no depth test, no depth writes).
+  glDisable(GL_DEPTH_TEST);
+  glDepthMask(GL_FALSE);
+  glUseProgram(r.skyProgram);
+  setMat(r.skyProgram, "uInvViewProj", inverse4(viewProj));
+  set3(r.skyProgram, "uCameraPos", camera.x, camera.y, camera.z);
+  set3(r.skyProgram, "uSunDir", sun);
+  set3(r.skyProgram, "uZenith", L.zenith);
+  set3(r.skyProgram, "uHorizon", L.horizon);
+  glBindVertexArray(r.emptyVao);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_LESS);
+
+  // Body shadow discs (shared by the ground and the tufts), from the primitives.
+  std::vector<float> shadows;
+  for (const BodyPartDraw* b : primitives) {
+    if (shadows.size() / 4 >= size_t(kMaxShadows)) break;
+    const Mat4& m = b->model;
+    const float ex = std::fabs(m[0]) + std::fabs(m[4]) + std::fabs(m[8]);
+    const float ey = std::fabs(m[1]) + std::fabs(m[5]) + std::fabs(m[9]);
+    const float ez = std::fabs(m[2]) + std::fabs(m[6]) + std::fabs(m[10]);
+    const float radius = b->shape == BodyPartDraw::Shape::Sphere ? ey : 0.5f * (ex + ez);
+    shadows.insert(shadows.end(), {m[12], m[14], radius, m[13] - ey});
+  }
+  // The blurred AO on unit 1 for every lit program (the textures of a pass use unit 0 and 2).
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_2D, r.aoValid ? r.aoTexture[1] : 0);
+  auto common = [&](GLuint p) {
+    glUseProgram(p);
+    setMat(p, "uViewProj", viewProj);
+    set3(p, "uCameraPos", camera.x, camera.y, camera.z);
+    set3(p, "uSunDir", sun);
+    set3(p, "uSunColour", L.sunColour);
+    set3(p, "uAmbient", L.ambient);
+    set3(p, "uFogColour", L.horizon);
+    glUniform1f(loc(p, "uFogDensity"), L.fogDensity);
+    glUniform1i(loc(p, "uShadowCount"), GLint(shadows.size() / 4));
+    if (!shadows.empty()) glUniform4fv(loc(p, "uShadows"), GLsizei(shadows.size() / 4), shadows.data());
+    glUniform1i(loc(p, "uSsao"), r.aoValid ? 1 : 0);
+    glUniform1i(loc(p, "uAo"), 1);
+    glUniform2f(loc(p, "uViewport"), float(width), float(height));
+  };
+
+  // 2. Ground.
+  if (r.ground.indices > 0) {
+    common(r.groundProgram);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, r.groundTexture);
+    glUniform1i(loc(r.groundProgram, "uGround"), 0);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, r.rockTexture);
+    glUniform1i(loc(r.groundProgram, "uRock"), 2);
+    glUniform1i(loc(r.groundProgram, "uRockBlend"), options.rockBlend ? 1 : 0);
+    glUniform2f(loc(r.groundProgram, "uRockCos"), std::cos(L.rockSlopeDegrees[0] * Camera::kRadians),
+                std::cos(L.rockSlopeDegrees[1] * Camera::kRadians));
+    glUniform1f(loc(r.groundProgram, "uGroundTile"), L.groundTileMetres);
+    glUniform1f(loc(r.groundProgram, "uGroundShade"), L.groundShade);
+    r.ground.draw();
+  }
+
+  // 3. Bodies.
+  if (!draws.empty()) {
+    common(r.bodyProgram);
+    for (const Draw& d : draws) {
+      const BodyPartDraw& b = *d.part;
+      setMat(r.bodyProgram, "uModel", b.model);
+      set3(r.bodyProgram, "uAlbedo", b.colour[0], b.colour[1], b.colour[2]);
+      glUniform1i(loc(r.bodyProgram, "uFootball"), b.pattern == BodyPartDraw::Pattern::Football ? 1 : 0);
+      d.mesh->draw();
+    }
+  }
+
+  // 4. Tufts.
+  if (n > 0) {
+    common(r.tuftProgram);
+    tuftUniforms(r.tuftProgram);
+    glUniform1i(loc(r.tuftProgram, "uAlphaToCoverage"), alphaToCoverage ? 1 : 0);
+    glUniform1i(loc(r.tuftProgram, "uHeatMap"), options.heatMap ? 1 : 0);
+    glBindVertexArray(r.tuftVao);
     if (alphaToCoverage) glEnable(GL_SAMPLE_ALPHA_TO_COVERAGE);
-    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(scene.tufts.size()));
+    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(n));
     if (alphaToCoverage) glDisable(GL_SAMPLE_ALPHA_TO_COVERAGE);
   }
+
+  // 5. Debug overlay: over everything (no depth test), unlit, unfogged.
+  const DebugScene& dbg = scene.debug;
+  if (options.debug.any() && (!dbg.lines.empty() || !dbg.points.empty())) {
+    std::vector<float> v;
+    v.reserve(dbg.lines.size() * 14 + dbg.points.size() * 7);
+    for (const DebugScene::Line& l : dbg.lines) {
+      v.insert(v.end(), {l.a[0], l.a[1], l.a[2], l.colour[0], l.colour[1], l.colour[2], 1.0f});
+      v.insert(v.end(), {l.b[0], l.b[1], l.b[2], l.colour[0], l.colour[1], l.colour[2], 1.0f});
+    }
+    for (const DebugScene::Point& q : dbg.points)
+      v.insert(v.end(), {q.p[0], q.p[1], q.p[2], q.colour[0], q.colour[1], q.colour[2], q.size});
+    glDisable(GL_DEPTH_TEST);
+    glEnable(GL_PROGRAM_POINT_SIZE);
+    glUseProgram(r.debugProgram);
+    setMat(r.debugProgram, "uViewProj", viewProj);
+    glBindVertexArray(r.debugVao);
+    glBindBuffer(GL_ARRAY_BUFFER, r.debugBuffer);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(v.size() * sizeof(float)), v.data(), GL_STREAM_DRAW);
+    if (!dbg.lines.empty()) glDrawArrays(GL_LINES, 0, GLsizei(dbg.lines.size() * 2));
+    if (!dbg.points.empty()) glDrawArrays(GL_POINTS, GLsizei(dbg.lines.size() * 2), GLsizei(dbg.points.size()));
+    glDisable(GL_PROGRAM_POINT_SIZE);
+    glEnable(GL_DEPTH_TEST);
+  }
+  glActiveTexture(GL_TEXTURE0);
   glBindVertexArray(0);
   glUseProgram(0);
 }

@@ -6,8 +6,13 @@
 //   3. bodies: unit spheres and cubes per part under their pose, Lambert + ambient (a football
 //      gets dark pentagons);
 //   4. tufts: one instance per tuft (simulated and edge ring), the vertex shader builds the quad;
-//      alpha test at 0.5 without MSAA, sharpened alpha to coverage with it; all normals up.
-// Everything is fogged toward the horizon colour. A GL context (3.3 core or later) with loaded
+//      alpha test at 0.5 without MSAA, sharpened alpha to coverage with it; all normals up;
+//      optionally tinted by their divergence heat;
+//   5. the debug overlay (lines and points of Scene::debug), over everything.
+// Everything is fogged toward the horizon colour. With SSAO on, a prepass renders depth and
+// normals (tufts only where their alpha passes), an occlusion pass at half resolution and a blur
+// feed the ambient term of steps 2-4. Steep ground blends to a rock texture. Bodies naming an
+// OBJ mesh draw it instead of their primitives (docs/rendering.md). A GL context (3.3 core or later) with loaded
 // entry points must be current for the whole life of a Renderer and a RenderTarget.
 #pragma once
 
@@ -31,6 +36,12 @@ struct Lighting {
   float fogDensity = 1.0f / 170.0f;                         ///< 1/m (exp2 fog)
   float groundTileMetres = 3.0f;                            ///< one ground-texture repeat
   float groundShade = 0.9f;                                 ///< the ground lies in the tufts' shade
+  /// Slopes (degrees) where the ground blends from grass to rock: starts, complete. Gentle by
+  /// default because the repository's hills (hilly-meadow) peak at 15 degrees; real meadows grow
+  /// on 30 degrees, so a rougher terrain may want {30, 45}.
+  std::array<float, 2> rockSlopeDegrees{9.0f, 14.0f};
+  float ssaoRadius = 0.5f;                                  ///< m: the SSAO neighbourhood
+  float ssaoStrength = 1.2f;                                ///< 1: all samples occluded -> no ambient
 };
 
 /// An offscreen framebuffer: colour + depth, multisampled when samples > 0 (resolved on read).
@@ -55,6 +66,15 @@ class RenderTarget {
   unsigned resolveFbo_ = 0, resolveColour_ = 0;
 };
 
+/// What to draw and how (the defaults reproduce the golden images).
+struct RenderOptions {
+  bool alphaToCoverage = true;  ///< needs a multisampled framebuffer, else alpha test
+  bool ssao = false;            ///< screen-space ambient occlusion; tufts write depth by their alpha
+  bool rockBlend = true;        ///< rock texture on steep terrain
+  bool heatMap = false;         ///< tint tufts by TuftInstance::heat (divergence overlay)
+  DebugFlags debug;             ///< layers of Scene::debug to draw
+};
+
 class Renderer {
  public:
   /// Compiles the shaders and builds the meshes. Throws std::runtime_error with the GL log.
@@ -70,6 +90,19 @@ class Renderer {
   /// texture are generated for the scene's atlas variants and seed (cached), the ground grid is
   /// uploaded when its revision changes.
   void draw(const Scene& scene, const Camera& camera, int width, int height, bool alphaToCoverage);
+  /// The same with every option (draw(..., bool) is draw(..., RenderOptions{alphaToCoverage})).
+  void draw(const Scene& scene, const Camera& camera, int width, int height, const RenderOptions& options);
+
+  /// Where relative mesh paths of BodyPartDraw::mesh are resolved (the scenario file's directory;
+  /// default: the working directory). Meshes are loaded once per resolved path and cached.
+  void setAssetDirectory(const std::string& directory);
+  /// The one-line error of the last mesh that failed to load ("" if none); such a body is drawn
+  /// as its primitives.
+  const std::string& lastAssetError() const;
+
+  /// The last frame's blurred ambient occlusion (half resolution, grey: 255 = open, 0 = fully
+  /// occluded), or an empty image when that frame had SSAO off. For tests and inspection.
+  Image readAmbientOcclusion();
 
   /// The atlas in use (generated on the first draw).
   const TuftAtlas* atlas() const;

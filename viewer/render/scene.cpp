@@ -2,10 +2,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <set>
 #include <cctype>
 #include <cmath>
 #include <string>
 
+#include "sim/collision/body_particles.h"
+#include "sim/math/scalar_ops.h"
+#include "sim/scenario/derived.h"
 #include "sim/world/world.h"
 
 namespace sg::viewer {
@@ -59,6 +63,8 @@ void paint(BodyPartDraw& d, const std::string& name, bool mower, size_t bodyInde
     return;
   }
   if (nameHas(name, "bunny")) return setColour(d, 0.72f, 0.66f, 0.58f);
+  if (nameHas(name, "rock") || nameHas(name, "stone")) return setColour(d, 0.46f, 0.44f, 0.41f);
+  if (nameHas(name, "crate")) return setColour(d, 0.60f, 0.42f, 0.22f);
   if (d.shape == BodyPartDraw::Shape::Box && nameHas(name, "box")) return setColour(d, 0.60f, 0.42f, 0.22f);
   static const float palette[][3] = {{0.25f, 0.40f, 0.75f}, {0.80f, 0.60f, 0.15f}, {0.55f, 0.25f, 0.60f},
                                      {0.20f, 0.60f, 0.60f}, {0.75f, 0.35f, 0.30f}};
@@ -155,6 +161,12 @@ void extractTyped(const World<S>& w, const Scenario& scenario, Scene* scene) {
     t.level = p.cut[k] ? uint8_t(3) : p.tiltLevel[k];  // thesis §5: mown tufts stay brighter
   }
   scene->simulatedTufts = n;
+  scene->windowOriginI = win.originI;
+  scene->windowOriginJ = win.originJ;
+  scene->windowWidth = win.sizeI;
+  scene->windowHeight = win.sizeJ;
+  scene->fieldPatchesX = win.fieldI;
+  scene->fieldPatchesZ = win.fieldJ;
 
   // Edge ring (level of detail): static tufts, standing straight.
   const EdgeRing<S>& ring = w.edgeRing();
@@ -175,12 +187,31 @@ void extractTyped(const World<S>& w, const Scenario& scenario, Scene* scene) {
     scene->tufts.push_back(t);
   }
 
-  // Bodies: one draw per part.
+  // Bodies: one draw per part; a body with a mesh is one mesh draw, its parts kept as proxies.
   scene->bodyParts.clear();
+  scene->meshProxies.clear();
   const auto& bodies = w.bodies();
   for (size_t b = 0; b < bodies.size(); ++b) {
     const RigidBody<S>& body = bodies[b];
-    const std::string name = b < scenario.bodies.list.size() ? scenario.bodies.list[b].name : std::string();
+    // A spawned body looks like the scenario body it copies (SimWorld::bodyTemplate).
+    const int32_t spec = w.bodyTemplate(int64_t(b));
+    const bool known = spec >= 0 && size_t(spec) < scenario.bodies.list.size();
+    const std::string name = known ? scenario.bodies.list[size_t(spec)].name : std::string();
+    const std::string mesh = known ? scenario.bodies.list[size_t(spec)].mesh : std::string();
+    if (!mesh.empty()) {
+      BodyPartDraw d;
+      d.shape = BodyPartDraw::Shape::Mesh;
+      d.mesh = mesh;
+      const Mat3<S>& rotation = body.rotation;
+      for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) d.model[size_t(c * 4 + r)] = float(toD(rotation(r, c)));
+      for (int r = 0; r < 3; ++r) d.model[size_t(12 + r)] = float(toD(body.position[r]));
+      paint(d, name, body.mower, b);
+      d.firstProxy = uint32_t(scene->meshProxies.size());
+      d.proxyCount = uint32_t(body.parts.size());
+      scene->bodyParts.push_back(d);
+    }
+    std::vector<BodyPartDraw>& target = mesh.empty() ? scene->bodyParts : scene->meshProxies;
     for (size_t i = 0; i < body.parts.size(); ++i) {
       const BodyPart<S>& part = body.parts[i];
       const Pose<S> pose = body.partPose(i);
@@ -197,7 +228,7 @@ void extractTyped(const World<S>& w, const Scenario& scenario, Scene* scene) {
         for (int r = 0; r < 3; ++r) d.model[size_t(c * 4 + r)] = float(toD(pose.rotation(r, c))) * scale[c];
       for (int r = 0; r < 3; ++r) d.model[size_t(12 + r)] = float(toD(pose.position[r]));
       paint(d, name, body.mower, b);
-      scene->bodyParts.push_back(d);
+      target.push_back(d);
     }
   }
 
@@ -218,12 +249,262 @@ void extractTyped(const World<S>& w, const Scenario& scenario, Scene* scene) {
   }
 }
 
+
+// ---- debug overlay ---------------------------------------------------------------------------
+
+using Line = DebugScene::Line;
+using Point = DebugScene::Point;
+
+void addLine(DebugScene* d, const float a[3], const float b[3], const float colour[3]) {
+  Line l;
+  for (int k = 0; k < 3; ++k) l.a[k] = a[k], l.b[k] = b[k], l.colour[k] = colour[k];
+  d->lines.push_back(l);
+}
+
+void addPoint(DebugScene* d, const float p[3], float size, const float colour[3]) {
+  Point q;
+  for (int k = 0; k < 3; ++k) q.p[k] = p[k], q.colour[k] = colour[k];
+  q.size = size;
+  d->points.push_back(q);
+}
+
+/// Wireframe of a primitive at a pose: a box's 12 edges, or a sphere's three great circles.
+template <class S>
+void addPrimitive(DebugScene* d, const BodyPart<S>& part, const Pose<S>& pose, const float colour[3]) {
+  float c[3], axes[3][3];  // centre; world axes scaled by the half extents or radius
+  for (int r = 0; r < 3; ++r) c[r] = float(toD(pose.position[r]));
+  for (int a = 0; a < 3; ++a) {
+    const float scale = float(toD(part.type == ShapeType::Sphere ? part.radius : part.halfExtents[a]));
+    for (int r = 0; r < 3; ++r) axes[a][r] = float(toD(pose.rotation(r, a))) * scale;
+  }
+  auto at = [&](float u, int ua, float v, int va, float w, int wa, float* out) {
+    for (int r = 0; r < 3; ++r) out[r] = c[r] + u * axes[ua][r] + v * axes[va][r] + w * axes[wa][r];
+  };
+  if (part.type == ShapeType::Sphere) {
+    constexpr int kSegments = 24;
+    for (int plane = 0; plane < 3; ++plane) {
+      const int ua = plane, va = (plane + 1) % 3, wa = (plane + 2) % 3;
+      for (int s = 0; s < kSegments; ++s) {
+        const float t0 = 6.2831853f * float(s) / kSegments, t1 = 6.2831853f * float(s + 1) / kSegments;
+        float a[3], b[3];
+        at(std::cos(t0), ua, std::sin(t0), va, 0, wa, a);
+        at(std::cos(t1), ua, std::sin(t1), va, 0, wa, b);
+        addLine(d, a, b, colour);
+      }
+    }
+    return;
+  }
+  for (int axis = 0; axis < 3; ++axis) {  // 4 edges along each axis
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    for (int k = 0; k < 4; ++k) {
+      const float su = (k & 1) ? 1.0f : -1.0f, sv = (k & 2) ? 1.0f : -1.0f;
+      float a[3], b[3];
+      at(-1, axis, su, u, sv, v, a);
+      at(1, axis, su, u, sv, v, b);
+      addLine(d, a, b, colour);
+    }
+  }
+}
+
+template <class S>
+void extractDebugTyped(const World<S>& w, const Scenario& scenario, const DebugFlags& flags, Scene* scene) {
+  DebugScene* d = &scene->debug;
+  d->lines.clear();
+  d->points.clear();
+  const ParticleArrays<S>& pa = w.particles();
+  const size_t n = size_t(w.particleGrid().size());
+  static const float kParticle[3] = {1.0f, 0.85f, 0.10f}, kRod[3] = {0.95f, 0.95f, 0.95f};
+  static const float kPrimitive[3] = {0.10f, 1.0f, 1.0f}, kCell[3] = {1.0f, 0.30f, 1.0f};
+  static const float kContact[3] = {1.0f, 0.10f, 0.10f};
+  for (size_t i = 0; i < n && (flags.particles || flags.constraints); ++i) {
+    const float p[3] = {float(toD(pa.px[i])), float(toD(pa.py[i])), float(toD(pa.pz[i]))};
+    if (flags.particles) addPoint(d, p, 2.0f, kParticle);
+    if (flags.constraints) {
+      const float root[3] = {float(toD(pa.anchorX[i])), float(toD(pa.anchorY[i])), float(toD(pa.anchorZ[i]))};
+      addLine(d, root, p, kRod);
+    }
+  }
+  if (flags.primitives)
+    for (const RigidBody<S>& body : w.bodies())
+      for (size_t i = 0; i < body.parts.size(); ++i) addPrimitive(d, body.parts[i], body.partPose(i), kPrimitive);
+  if (flags.cells) {
+    // The body-particle broad phase's candidate cells (sim/collision/body_particles.h): the same
+    // ranges the collision stage computes, from the same settings World<S> derives.
+    const ScenarioConstants c = deriveConstants(scenario);
+    BodyParticleSettings<S> settings;
+    settings.broadphase = ParticleBroadphase::Grid;  // brute has no cells; show what grid would test
+    S largest(0);
+    for (const RigidBody<S>& b : w.bodies()) largest = maxS(largest, b.boundingRadius);
+    settings.margin = fromD<S>(scenario.particles.constraintLength.toDouble()) + w.lattice().jitterAmplitude + largest;
+    settings.anchorOriginX = w.lattice().originX;
+    settings.anchorOriginZ = w.lattice().originZ;
+    settings.invParticleSpacing = fromD<S>(c.invParticleSpacing.toDouble());
+    std::set<std::pair<int64_t, int64_t>> cells;  // ordered: a deterministic line order
+    for (const ParticleRange& r : particleRanges(w.bodies(), w.particleGrid(), settings))
+      for (int64_t b = r.b0; b <= r.b1; ++b)
+        for (int64_t a = r.a0; a <= r.a1; ++a) cells.insert({b, a});
+    // Cell (a, b) is the square of one particle spacing around particle (a, b)'s un-jittered
+    // anchor, drawn 2 cm above the terrain at its centre.
+    const double ks = 1.0 / c.invParticleSpacing.toDouble();
+    const double ox = toD(w.lattice().originX), oz = toD(w.lattice().originZ);
+    for (const auto& [b, a] : cells) {
+      const double x0 = ox + (double(a) - 0.5) * ks, x1 = x0 + ks, z0 = oz + (double(b) - 0.5) * ks, z1 = z0 + ks;
+      const float y = float(toD(w.terrain().heightAt(fromD<S>(0.5 * (x0 + x1)), fromD<S>(0.5 * (z0 + z1))))) + 0.02f;
+      const float corners[4][3] = {{float(x0), y, float(z0)}, {float(x1), y, float(z0)}, {float(x1), y, float(z1)},
+                                   {float(x0), y, float(z1)}};
+      for (int k = 0; k < 4; ++k) addLine(d, corners[k], corners[(k + 1) % 4], kCell);
+    }
+  }
+  if (flags.contacts)
+    for (const Contact<S>& ct : w.contacts()) {
+      const float p[3] = {float(toD(ct.point.x())), float(toD(ct.point.y())), float(toD(ct.point.z()))};
+      const float q[3] = {p[0] + 0.25f * float(toD(ct.normal.x())), p[1] + 0.25f * float(toD(ct.normal.y())),
+                          p[2] + 0.25f * float(toD(ct.normal.z()))};
+      addPoint(d, p, 7.0f, kContact);
+      addLine(d, p, q, kContact);
+    }
+}
+
+// ---- interpolation ---------------------------------------------------------------------------
+
+/// Rotation quaternion (w, x, y, z) of a model matrix's upper 3x3 after dividing out the column
+/// scales (Shepperd's method).
+void toQuaternion(const Mat4& m, const float scale[3], float q[4]) {
+  auto R = [&](int r, int c) { return m[size_t(c * 4 + r)] / scale[c]; };
+  const float trace = R(0, 0) + R(1, 1) + R(2, 2);
+  if (trace > 0) {
+    const float s = 2 * std::sqrt(trace + 1);
+    q[0] = 0.25f * s, q[1] = (R(2, 1) - R(1, 2)) / s, q[2] = (R(0, 2) - R(2, 0)) / s, q[3] = (R(1, 0) - R(0, 1)) / s;
+  } else if (R(0, 0) > R(1, 1) && R(0, 0) > R(2, 2)) {
+    const float s = 2 * std::sqrt(1 + R(0, 0) - R(1, 1) - R(2, 2));
+    q[0] = (R(2, 1) - R(1, 2)) / s, q[1] = 0.25f * s, q[2] = (R(0, 1) + R(1, 0)) / s, q[3] = (R(0, 2) + R(2, 0)) / s;
+  } else if (R(1, 1) > R(2, 2)) {
+    const float s = 2 * std::sqrt(1 + R(1, 1) - R(0, 0) - R(2, 2));
+    q[0] = (R(0, 2) - R(2, 0)) / s, q[1] = (R(0, 1) + R(1, 0)) / s, q[2] = 0.25f * s, q[3] = (R(1, 2) + R(2, 1)) / s;
+  } else {
+    const float s = 2 * std::sqrt(1 + R(2, 2) - R(0, 0) - R(1, 1));
+    q[0] = (R(1, 0) - R(0, 1)) / s, q[1] = (R(0, 2) + R(2, 0)) / s, q[2] = (R(1, 2) + R(2, 1)) / s, q[3] = 0.25f * s;
+  }
+}
+
+/// Interpolated part pose: translation lerped, rotation slerped (shortest arc), current's scale.
+Mat4 lerpModel(const Mat4& a, const Mat4& b, float t) {
+  float sa[3], sb[3];
+  for (int c = 0; c < 3; ++c) {
+    sa[c] = std::sqrt(a[size_t(c * 4)] * a[size_t(c * 4)] + a[size_t(c * 4 + 1)] * a[size_t(c * 4 + 1)] +
+                      a[size_t(c * 4 + 2)] * a[size_t(c * 4 + 2)]);
+    sb[c] = std::sqrt(b[size_t(c * 4)] * b[size_t(c * 4)] + b[size_t(c * 4 + 1)] * b[size_t(c * 4 + 1)] +
+                      b[size_t(c * 4 + 2)] * b[size_t(c * 4 + 2)]);
+    if (sa[c] < 1e-12f || sb[c] < 1e-12f) return b;  // degenerate: no rotation to recover
+  }
+  float qa[4], qb[4], q[4];
+  toQuaternion(a, sa, qa);
+  toQuaternion(b, sb, qb);
+  float dot = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3];
+  if (dot < 0) {
+    for (float& v : qb) v = -v;
+    dot = -dot;
+  }
+  float wa = 1 - t, wb = t;
+  if (dot < 0.9995f) {  // slerp; nearly parallel: the lerp below is as good and stable
+    const float theta = std::acos(std::min(dot, 1.0f)), s = std::sin(theta);
+    wa = std::sin((1 - t) * theta) / s;
+    wb = std::sin(t * theta) / s;
+  }
+  float len = 0;
+  for (int k = 0; k < 4; ++k) q[k] = wa * qa[k] + wb * qb[k], len += q[k] * q[k];
+  len = std::sqrt(len);
+  for (float& v : q) v /= len;
+  const float w = q[0], x = q[1], y = q[2], z = q[3];
+  const float R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+                         {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+                         {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}};
+  Mat4 m = b;
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) m[size_t(c * 4 + r)] = R[r][c] * sb[c];
+  for (int r = 0; r < 3; ++r) m[size_t(12 + r)] = a[size_t(12 + r)] + (b[size_t(12 + r)] - a[size_t(12 + r)]) * t;
+  return m;
+}
+
+void lerpParts(const std::vector<BodyPartDraw>& previous, std::vector<BodyPartDraw>* parts, float t) {
+  if (previous.size() != parts->size()) return;
+  for (size_t i = 0; i < parts->size(); ++i)
+    if (previous[i].shape == (*parts)[i].shape) (*parts)[i].model = lerpModel(previous[i].model, (*parts)[i].model, t);
+}
+
 }  // namespace
 
 void extractScene(const SimWorld& world, const Scenario& scenario, Scene* scene) {
   dispatchScalar(world.scalar(), [&]<class S>() {
     if (const World<S>* w = typed<S>(world)) extractTyped(*w, scenario, scene);
   });
+}
+
+void extractDebug(const SimWorld& world, const Scenario& scenario, const DebugFlags& flags, Scene* scene) {
+  scene->debug.lines.clear();
+  scene->debug.points.clear();
+  if (!flags.any()) return;
+  dispatchScalar(world.scalar(), [&]<class S>() {
+    if (const World<S>* w = typed<S>(world)) extractDebugTyped(*w, scenario, flags, scene);
+  });
+}
+
+void interpolateScene(const Scene& previous, const Scene& current, float alpha, Scene* out) {
+  *out = current;
+  const float t = std::clamp(alpha, 0.0f, 1.0f);
+  if (t >= 1.0f) return;  // exactly current
+  if (t <= 0.0f) {        // exactly previous' tufts and poses, current's everything else
+    if (previous.tufts.size() == current.tufts.size() && previous.simulatedTufts == current.simulatedTufts &&
+        previous.windowOriginI == current.windowOriginI && previous.windowOriginJ == current.windowOriginJ &&
+        previous.windowWidth == current.windowWidth && previous.windowHeight == current.windowHeight)
+      out->tufts = previous.tufts;
+    if (previous.bodyParts.size() == current.bodyParts.size()) out->bodyParts = previous.bodyParts;
+    if (previous.meshProxies.size() == current.meshProxies.size()) out->meshProxies = previous.meshProxies;
+    return;
+  }
+  // The same layout: the same window (origin and size) holds the same patches in the same slots.
+  const bool sameLayout = previous.simulatedTufts == current.simulatedTufts &&
+                          previous.tufts.size() >= previous.simulatedTufts &&
+                          previous.windowOriginI == current.windowOriginI &&
+                          previous.windowOriginJ == current.windowOriginJ &&
+                          previous.windowWidth == current.windowWidth && previous.windowHeight == current.windowHeight;
+  if (sameLayout)
+    for (size_t k = 0; k < current.simulatedTufts; ++k) {
+      const TuftInstance& a = previous.tufts[k];
+      TuftInstance& o = out->tufts[k];
+      o.topY = a.topY + (o.topY - a.topY) * t;
+      o.tipX = a.tipX + (o.tipX - a.tipX) * t;
+      o.tipZ = a.tipZ + (o.tipZ - a.tipZ) * t;
+    }
+  lerpParts(previous.bodyParts, &out->bodyParts, t);
+  lerpParts(previous.meshProxies, &out->meshProxies, t);
+}
+
+void applyDivergenceHeat(const Observation& a, const Observation& b, float fullScaleMetres, Scene* scene) {
+  for (TuftInstance& t : scene->tufts) t.heat = 0;
+  const size_t patches = size_t(std::max<int64_t>(0, a.patchesX * a.patchesZ));
+  if (a.patchesX != b.patchesX || a.patchesZ != b.patchesZ || a.tipX.size() < patches || b.tipX.size() < patches ||
+      a.tipY.size() < patches || b.tipY.size() < patches || a.tipZ.size() < patches || b.tipZ.size() < patches ||
+      a.patchesX != scene->fieldPatchesX || a.patchesZ != scene->fieldPatchesZ || !(fullScaleMetres > 0))
+    return;
+  // Storage slot k of the (toroidal) window holds lattice patch (latticeColumn(c), latticeRow(r)).
+  LatticeWindow win;
+  win.originI = scene->windowOriginI;
+  win.originJ = scene->windowOriginJ;
+  win.sizeI = scene->windowWidth;
+  win.sizeJ = scene->windowHeight;
+  win.fieldI = scene->fieldPatchesX;
+  win.fieldJ = scene->fieldPatchesZ;
+  const size_t n = std::min(scene->simulatedTufts, scene->tufts.size());
+  if (win.sizeI <= 0 || size_t(win.size()) != n) return;
+  for (size_t k = 0; k < n; ++k) {
+    const int64_t i = win.latticeColumn(int64_t(k) % win.sizeI), j = win.latticeRow(int64_t(k) / win.sizeI);
+    if (!win.insideField(i, j)) continue;
+    const size_t p = size_t(j * a.patchesX + i);
+    const double dx = a.tipX[p] - b.tipX[p], dy = a.tipY[p] - b.tipY[p], dz = a.tipZ[p] - b.tipZ[p];
+    const double x = std::sqrt(dx * dx + dy * dy + dz * dz) / double(fullScaleMetres);
+    scene->tufts[k].heat = uint8_t(std::lround(255.0 * std::clamp(x, 0.0, 1.0)));
+  }
 }
 
 float groundHeight(const SimWorld& world, float x, float z) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "viewer/render/camera.h"
@@ -11,6 +12,7 @@
 namespace sg {
 class SimWorld;
 struct Scenario;
+struct Observation;
 }  // namespace sg
 
 namespace sg::viewer {
@@ -25,16 +27,37 @@ struct TuftInstance {
   float angle;          ///< radians (rotation / 65536 turns)
   uint8_t variant;      ///< atlas column: 0..variants-1, variants = the white marking tuft
   uint8_t level;        ///< atlas row: brightness 0..3 (tilt level; mown tufts are brightest)
-  uint8_t pad[2] = {0, 0};
+  uint8_t heat = 0;     ///< divergence overlay: 0 = none .. 255 = full scale (applyDivergenceHeat)
+  uint8_t pad = 0;
 };
 
 /// One body part: a unit sphere or a unit cube (-1..1) under `model` (translation, rotation,
-/// scale by the radius or half extents).
+/// scale by the radius or half extents), or a user mesh (Shape::Mesh: `mesh` is the OBJ path as
+/// the scenario names it, drawn in body-local metres under `model`, which then holds the body's
+/// pose without scale; `proxies` are the collision primitives drawn when the mesh fails to load).
 struct BodyPartDraw {
-  enum class Shape : uint8_t { Sphere, Box } shape = Shape::Sphere;
+  enum class Shape : uint8_t { Sphere, Box, Mesh } shape = Shape::Sphere;
   enum class Pattern : uint8_t { Plain, Football } pattern = Pattern::Plain;
   Mat4 model = identity4();
   float colour[3] = {0.8f, 0.8f, 0.8f};  ///< linear RGB albedo
+  std::string mesh;                       ///< Shape::Mesh: OBJ path (relative: the asset directory)
+  uint32_t firstProxy = 0, proxyCount = 0;  ///< Shape::Mesh: the body's primitive parts in
+                                            ///< Scene::meshProxies (the fallback when the mesh fails)
+};
+
+/// Debug overlay geometry (extractDebug): world-space lines and points, linear RGB colours.
+struct DebugScene {
+  struct Line {
+    float a[3], b[3];
+    float colour[3];
+  };
+  struct Point {
+    float p[3];
+    float size;  ///< pixels
+    float colour[3];
+  };
+  std::vector<Line> lines;
+  std::vector<Point> points;
 };
 
 /// The ground: heights on a rectilinear grid (xs x zs), row-major (z rows, x fastest). The inner
@@ -54,7 +77,13 @@ struct Scene {
   std::vector<TuftInstance> tufts;  ///< simulated tufts first, then the edge ring
   size_t simulatedTufts = 0;
   std::vector<BodyPartDraw> bodyParts;
+  std::vector<BodyPartDraw> meshProxies;  ///< primitives of mesh bodies (drawn if a mesh fails)
   GroundGrid ground;
+  DebugScene debug;                 ///< overlay (extractDebug; drawn per RenderOptions::debug)
+  /// The simulated tufts' layout: the LOD window's first patch (i, j) and size, and the field's
+  /// patch columns. Two scenes with equal layouts hold the same patches in the same slots.
+  int64_t windowOriginI = 0, windowOriginJ = 0, windowWidth = 0, windowHeight = 0;
+  int64_t fieldPatchesX = 0, fieldPatchesZ = 0;
   /// Where the simulated grass is (the level-of-detail window, else the field), m.
   float focusMinX = 0, focusMaxX = 0, focusMinZ = 0, focusMaxZ = 0;
   float groundHeightAtFocus = 0;  ///< terrain height at the focus centre
@@ -67,6 +96,30 @@ struct Scene {
 /// times wider than the grass: they stand edgeSpacing spacings apart, and a wider quad keeps the
 /// ring about as dense.
 void extractScene(const SimWorld& world, const Scenario& scenario, Scene* scene);
+
+/// Which debug overlay layers to build / draw.
+struct DebugFlags {
+  bool particles = false, constraints = false, primitives = false, cells = false, contacts = false;
+  bool any() const { return particles || constraints || primitives || cells || contacts; }
+};
+
+/// Fills scene->debug from the world's current state (replacing what it held): particles (a
+/// point per particle of the simulated window), constraints (root -> particle lines), body
+/// primitives (wireframe spheres and boxes at their poses, mower parts included), broad-phase
+/// cells (outline of every occupied particle-grid cell) and contacts (a point and a short normal
+/// line each), as `flags` ask.
+void extractDebug(const SimWorld& world, const Scenario& scenario, const DebugFlags& flags, Scene* scene);
+
+/// Display-only interpolation between the last two ticks, alpha in [0, 1] (0: previous, 1:
+/// current). Tuft tops lerp where both scenes have the same tuft layout, else `out` takes
+/// current's tufts; body parts lerp translation and slerp rotation when the part counts match.
+/// The ground and everything else come from `current`. Never feeds back into the simulation.
+void interpolateScene(const Scene& previous, const Scene& current, float alpha, Scene* out);
+
+/// Sets the simulated tufts' `heat` from |tipA - tipB| / fullScaleMetres (clamped to 1, scaled to
+/// 255) of the two full-field observations; patches outside the LOD window have no tuft. Edge-ring
+/// tufts get 0.
+void applyDivergenceHeat(const Observation& a, const Observation& b, float fullScaleMetres, Scene* scene);
 
 /// Terrain height (m) at (x, z) of the world, for camera placement.
 float groundHeight(const SimWorld& world, float x, float z);

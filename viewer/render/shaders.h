@@ -14,9 +14,16 @@ uniform vec3 uFogColour;
 uniform float uFogDensity; // 1/m
 uniform vec4 uShadows[16]; // body shadow discs: x, z, radius, height of the body's bottom
 uniform int uShadowCount;
+uniform bool uSsao;        // screen-space ambient occlusion on: uAo holds it for this frame
+uniform sampler2D uAo;     // blurred AO (1 = open), half resolution, covers the viewport
+uniform vec2 uViewport;    // pixels
 
+// The ambient light reaching this pixel: the sky's, less what the neighbourhood occludes (SSAO).
+float ambientOcclusion() {
+  return uSsao ? texture(uAo, gl_FragCoord.xy / uViewport).r : 1.0;
+}
 vec3 lit(vec3 albedo, vec3 n) {
-  return albedo * (uAmbient + uSunColour * max(dot(n, uSunDir), 0.0));
+  return albedo * (uAmbient * ambientOcclusion() + uSunColour * max(dot(n, uSunDir), 0.0));
 }
 vec3 fogged(vec3 colour, vec3 world) {
   float d = distance(world, uCameraPos) * uFogDensity;
@@ -41,13 +48,14 @@ float shadowAt(vec3 world) {
 inline constexpr const char* kTuftVertex = R"GLSL(#version 330 core
 layout(location = 0) in vec4 aRoot;  // root x, y, z; half width
 layout(location = 1) in vec4 aTop;   // top y; tip offset x, z; angle (rad)
-layout(location = 2) in vec2 aTile;  // atlas variant, brightness level
+layout(location = 2) in vec3 aTile;  // atlas variant, brightness level, divergence heat 0..255
 uniform mat4 uViewProj;
 uniform vec4 uTiles[68];             // (variants + 1) * levels tile rects: u0, v0 (top), u1, v1
 uniform int uLevels;
 out vec2 vUv;
 out float vUp;                       // 0 at the root, 1 at the top
 out vec3 vWorld;
+out float vHeat;                     // 0..1
 void main() {
   // Triangle strip 0..3: bottom-left, bottom-right, top-left, top-right (thesis §2 vertices).
   int corner = gl_VertexID;
@@ -59,6 +67,7 @@ void main() {
   vec4 tile = uTiles[int(aTile.x + 0.5) * uLevels + int(aTile.y + 0.5)];
   vUv = vec2(side < 0.0 ? tile.x : tile.z, top ? tile.y : tile.w);
   vUp = top ? 1.0 : 0.0;
+  vHeat = aTile.z / 255.0;
   vWorld = p;
   gl_Position = uViewProj * vec4(p, 1.0);
 }
@@ -68,10 +77,17 @@ inline constexpr const char* kTuftFragment = R"GLSL(
 uniform sampler2D uAtlas;
 uniform vec2 uAtlasSize;
 uniform bool uAlphaToCoverage;
+uniform bool uHeatMap;
 in vec2 vUv;
 in float vUp;
 in vec3 vWorld;
+in float vHeat;
 out vec4 fragColour;
+// Divergence heat: blue (small) - yellow - red (full scale).
+vec3 heatColour(float h) {
+  return h < 0.5 ? mix(vec3(0.15, 0.35, 1.0), vec3(1.0, 0.9, 0.1), 2.0 * h)
+                 : mix(vec3(1.0, 0.9, 0.1), vec3(1.0, 0.08, 0.04), 2.0 * h - 1.0);
+}
 void main() {
   vec4 t = texture(uAtlas, vUv);
   // Mipmaps average the blades' alpha away with distance; scale it back up by the mip level so
@@ -91,6 +107,7 @@ void main() {
   // All normals up (thesis §2): both faces light alike. Darker toward the root stands in for the
   // thesis' SSAO (the lower part of a tuft sits in the others' shade).
   vec3 c = lit(t.rgb, vec3(0.0, 1.0, 0.0)) * mix(0.42, 1.0, vUp) * shadowAt(vWorld);
+  if (uHeatMap && vHeat > 0.0) c = mix(c, heatColour(vHeat) * mix(0.55, 1.0, vUp), 0.85);
   fragColour = vec4(fogged(c, vWorld), a);
 }
 )GLSL";
@@ -112,6 +129,9 @@ inline constexpr const char* kGroundFragment = R"GLSL(
 uniform sampler2D uGround;
 uniform float uGroundTile;  // m per texture repeat
 uniform float uGroundShade; // the ground is the shaded floor under the tufts
+uniform sampler2D uRock;
+uniform bool uRockBlend;    // rock on steep slopes
+uniform vec2 uRockCos;      // cos of the slopes where the rock starts and where it is complete
 in vec3 vWorld;
 in vec3 vNormal;
 out vec4 fragColour;
@@ -120,7 +140,19 @@ void main() {
   vec3 near = texture(uGround, vWorld.xz / uGroundTile).rgb;
   vec3 far = texture(uGround, mat2(0.8, -0.6, 0.6, 0.8) * vWorld.xz / (2.7 * uGroundTile) + vec2(0.31, 0.57)).rgb;
   vec3 albedo = mix(near, far, 0.45) * uGroundShade;
-  vec3 c = lit(albedo, normalize(vNormal)) * shadowAt(vWorld);
+  vec3 n = normalize(vNormal);
+  // Rock from the slope uRockCos.x to uRockCos.y (cosines: n.y = cos(slope)); flat ground keeps
+  // the grass texture exactly. Sampled on the two horizontal planes the slope faces most
+  // (triplanar without the top plane), so steep faces do not show stretched texels.
+  // (Sampled outside the branch: mipmapped lookups need derivatives in uniform control flow.)
+  vec3 w = abs(n) + 1e-4;
+  vec2 scale = vec2(1.0 / (1.3 * uGroundTile));
+  vec3 rx = texture(uRock, vWorld.zy * scale + vec2(0.17, 0.43)).rgb;
+  vec3 rz = texture(uRock, vWorld.xy * scale + vec2(0.61, 0.09)).rgb;
+  vec3 ry = texture(uRock, vWorld.xz * scale).rgb;
+  float rock = uRockBlend ? 1.0 - smoothstep(uRockCos.y, uRockCos.x, n.y) : 0.0;
+  if (rock > 0.0) albedo = mix(albedo, (rx * w.x + ry * w.y + rz * w.z) / (w.x + w.y + w.z), rock);
+  vec3 c = lit(albedo, n) * shadowAt(vWorld);
   fragColour = vec4(fogged(c, vWorld), 1.0);
 }
 )GLSL";
@@ -200,6 +232,132 @@ void main() {
   c += vec3(1.0, 0.95, 0.8) * (pow(toSun, 600.0) * 0.8 + pow(toSun, 12.0) * 0.12);
   fragColour = vec4(min(c, vec3(1.0)), 1.0);
 }
+)GLSL";
+
+// ---- SSAO (docs/rendering.md): a depth + normal prepass, the occlusion at half resolution, a
+// 4x4 blur; lit() then scales the ambient term by it. ------------------------------------------
+
+/// Prepass of ground, bodies and meshes: view-space normal (encoded 0..1), depth by the depth test.
+/// The normal is turned toward the camera: a visible surface's occlusion is on its visible side,
+/// whatever the mesh's winding.
+inline constexpr const char* kPrepassSolidFragment = R"GLSL(#version 330 core
+uniform mat4 uView;
+uniform vec3 uCameraPos;
+in vec3 vWorld;
+in vec3 vNormal;
+out vec4 fragNormal;
+void main() {
+  vec3 n = normalize(vNormal);
+  if (dot(n, uCameraPos - vWorld) < 0.0) n = -n;
+  fragNormal = vec4(normalize(mat3(uView) * n) * 0.5 + 0.5, 1.0);
+}
+)GLSL";
+
+/// Prepass of the tufts: depth only where the atlas alpha passes the main pass' alpha test, so
+/// the gaps between blades do not occlude (no quad-shaped occlusion). Normals up, as lit.
+inline constexpr const char* kPrepassTuftFragment = R"GLSL(#version 330 core
+uniform mat4 uView;
+uniform sampler2D uAtlas;
+uniform vec2 uAtlasSize;
+in vec2 vUv;
+out vec4 fragNormal;
+void main() {
+  vec4 t = texture(uAtlas, vUv);
+  vec2 tx = dFdx(vUv * uAtlasSize), ty = dFdy(vUv * uAtlasSize);
+  float mip = max(0.0, 0.5 * log2(max(dot(tx, tx), dot(ty, ty))));
+  if (t.a * (1.0 + 0.25 * mip) < 0.5) discard;
+  fragNormal = vec4(normalize(mat3(uView) * vec3(0.0, 1.0, 0.0)) * 0.5 + 0.5, 1.0);
+}
+)GLSL";
+
+inline constexpr const char* kFullscreenVertex = R"GLSL(#version 330 core
+out vec2 vUv;
+void main() {
+  vec2 p = vec2((gl_VertexID == 1) ? 3.0 : -1.0, (gl_VertexID == 2) ? 3.0 : -1.0);
+  vUv = p * 0.5 + 0.5;
+  gl_Position = vec4(p, 0.0, 1.0);
+}
+)GLSL";
+
+/// Normal-oriented hemisphere SSAO (Crytek / Chapman): 16 kernel samples within uRadius metres,
+/// turned per pixel by one of 16 angles in a 4x4 pattern (the blur removes the pattern); a sample
+/// counts as occluded when the depth buffer holds a surface in front of it, weighted down when
+/// that surface is much farther than the radius (a range check: no dark halos at silhouettes).
+inline constexpr const char* kSsaoFragment = R"GLSL(#version 330 core
+uniform sampler2D uDepth;
+uniform sampler2D uNormal;
+uniform mat4 uProj;
+uniform mat4 uInvProj;
+uniform vec3 uKernel[16];
+uniform float uRadius;    // m
+uniform float uStrength;  // 1: fully occluded samples give AO 0
+in vec2 vUv;
+out vec4 fragAo;
+vec3 viewPos(vec2 uv) {
+  float d = texture(uDepth, uv).r;
+  vec4 p = uInvProj * vec4(vec3(uv, d) * 2.0 - 1.0, 1.0);
+  return p.xyz / p.w;
+}
+void main() {
+  if (texture(uDepth, vUv).r >= 1.0) { fragAo = vec4(1.0); return; }  // sky
+  vec3 p = viewPos(vUv);
+  vec3 n = normalize(texture(uNormal, vUv).xyz * 2.0 - 1.0);
+  ivec2 q = ivec2(gl_FragCoord.xy) & 3;
+  const int bayer[16] = int[16](0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5);
+  float angle = 6.2831853 * (float(bayer[q.y * 4 + q.x]) + 0.5) / 16.0;
+  vec3 r = vec3(cos(angle), sin(angle), 0.0);
+  vec3 t = r - n * dot(r, n);
+  t = dot(t, t) > 1e-6 ? normalize(t) : normalize(cross(n, vec3(0.0, 0.0, 1.0)));
+  mat3 tbn = mat3(t, cross(n, t), n);
+  float occlusion = 0.0;
+  for (int i = 0; i < 16; ++i) {
+    vec3 s = p + tbn * uKernel[i] * uRadius;
+    vec4 o = uProj * vec4(s, 1.0);
+    vec2 suv = o.xy / o.w * 0.5 + 0.5;
+    if (any(lessThan(suv, vec2(0.0))) || any(greaterThan(suv, vec2(1.0)))) continue;
+    float sceneZ = viewPos(suv).z;
+    float range = smoothstep(0.0, 1.0, uRadius / max(abs(p.z - sceneZ), 1e-4));
+    occlusion += (sceneZ >= s.z + 0.02 * uRadius ? 1.0 : 0.0) * range;
+  }
+  float ao = clamp(1.0 - uStrength * occlusion / 16.0, 0.0, 1.0);
+  // Far away a pixel spans more than the radius and depth precision fails: fade out (40-80 m).
+  fragAo = vec4(vec3(mix(ao, 1.0, smoothstep(40.0, 80.0, -p.z))), 1.0);
+}
+)GLSL";
+
+/// 4x4 box blur of the AO (the size of the rotation pattern).
+inline constexpr const char* kBlurFragment = R"GLSL(#version 330 core
+uniform sampler2D uSource;
+out vec4 fragAo;
+void main() {
+  ivec2 size = textureSize(uSource, 0);
+  ivec2 c = ivec2(gl_FragCoord.xy);
+  float sum = 0.0;
+  for (int y = -2; y < 2; ++y)
+    for (int x = -2; x < 2; ++x) sum += texelFetch(uSource, clamp(c + ivec2(x, y), ivec2(0), size - 1), 0).r;
+  fragAo = vec4(vec3(sum / 16.0), 1.0);
+}
+)GLSL";
+
+// ---- debug overlay ----------------------------------------------------------------------------
+
+inline constexpr const char* kDebugVertex = R"GLSL(#version 330 core
+layout(location = 0) in vec3 aPosition;
+layout(location = 1) in vec3 aColour;
+layout(location = 2) in float aSize;  // point size, pixels
+uniform mat4 uViewProj;
+out vec3 vColour;
+void main() {
+  vColour = aColour;
+  gl_PointSize = aSize;
+  gl_Position = uViewProj * vec4(aPosition, 1.0);
+}
+)GLSL";
+
+inline constexpr const char* kDebugFragment = R"GLSL(#version 330 core
+in vec3 vColour;
+out vec4 fragColour;
+void main() { fragColour = vec4(vColour, 1.0); }
 )GLSL";
 
 }  // namespace sg::viewer::shaders

@@ -276,15 +276,16 @@ def build(data):
     ip = payload(data, inpt)
     assert ip[8] == 0 and struct.unpack_from("<I", ip, 9)[0] >= 1, "the first INPT should carry a command"
     body_at = 13
+    # Body indices up to 63 may name spawned bodies (kMaxBodies = 64): 70 can never exist.
     add("inpt-body-out-of-range.sgr", "body-index",
-        replace_chunk(data, inpt, frame(b"INPT", ip[:body_at] + struct.pack("<i", 7) + ip[body_at + 4:])),
-        {"outcome": "error", "offset": inpt[0] + 8, "message": "commands for the scenario's 1 bodies, got body 7"})
+        replace_chunk(data, inpt, frame(b"INPT", ip[:body_at] + struct.pack("<i", 70) + ip[body_at + 4:])),
+        {"outcome": "error", "offset": inpt[0] + 8, "message": "commands for at most 64 bodies, got body 70"})
     add("inpt-body-negative.sgr", "inpt-field",
         replace_chunk(data, inpt, frame(b"INPT", ip[:body_at] + struct.pack("<i", -1) + ip[body_at + 4:])),
         {"outcome": "error", "offset": inpt[0] + 8 + body_at, "message": "a body index >= 0, got -1"})
     add("inpt-command-kind.sgr", "inpt-field",
         replace_chunk(data, inpt, frame(b"INPT", ip[:body_at + 4] + b"\x09" + ip[body_at + 5:])),
-        {"outcome": "error", "offset": inpt[0] + 8 + body_at + 4, "message": "a command kind 0..3, got 9"})
+        {"outcome": "error", "offset": inpt[0] + 8 + body_at + 4, "message": "a command kind 0..7, got 9"})
     add("inpt-command-count.sgr", "inpt-field",
         replace_chunk(data, inpt, frame(b"INPT", ip[:9] + struct.pack("<I", 0x10000000) + ip[13:])),
         {"outcome": "error", "offset": inpt[0] + 8 + 9, "message": "a command count that fits the INPT chunk"})

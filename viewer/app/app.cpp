@@ -1,0 +1,446 @@
+#include "viewer/app/app.h"
+
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+
+#include <dlfcn.h>
+#include <link.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+
+#include "viewer/app/text.h"
+
+// Sanitizer builds: the GL driver (Mesa's GLX and llvmpipe, LLVM) and libX11 keep allocations
+// to the end of the process; LeakSanitizer would report them as ours. (This executable never
+// links the offscreen library, whose hooks are for OSMesa: each executable defines its own.)
+#if defined(__SANITIZE_ADDRESS__)
+#define SIMGRASS_VIEWER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define SIMGRASS_VIEWER_ASAN 1
+#endif
+#endif
+#ifdef SIMGRASS_VIEWER_ASAN
+extern "C" __attribute__((visibility("default"), used)) const char* __lsan_default_suppressions() {
+  return "leak:libGLX_mesa.so\nleak:libGLX.so\nleak:swrast_dri.so\nleak:libgallium\nleak:libLLVM\n"
+         "leak:libglapi.so\nleak:libX11.so\nleak:libxcb\nleak:libglfw.so\nleak:libdbus\n";
+}
+extern "C" __attribute__((visibility("default"), used)) const char* __lsan_default_options() {
+  return "print_suppressions=0";
+}
+#endif
+
+namespace sg::viewer {
+namespace {
+/// Sanitizer builds: keeps every library loaded so far (the GL driver included) mapped until the
+/// process ends. GLVND unloads the driver at glfwTerminate, and a leak whose stack lies in an
+/// unloaded library has "<unknown module>" frames that no suppression can name.
+void pinLoadedLibraries() {
+#ifdef SIMGRASS_VIEWER_ASAN
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, size_t, void*) {
+        if (info->dlpi_name && info->dlpi_name[0]) dlopen(info->dlpi_name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+        return 0;
+      },
+      nullptr);
+#endif
+}
+}  // namespace
+
+App::App(Options o, std::unique_ptr<Session> live, std::unique_ptr<Playback> playback)
+    : opt_(std::move(o)), live_(std::move(live)), play_(std::move(playback)) {
+  resetEdits();
+}
+
+std::function<float(float, float)> App::ground() {
+  return [this](float x, float z) { return groundHeight(world(), x, z); };
+}
+
+bool App::open(std::string* error) {
+  if (!glfwInit()) {
+    const char* desc = nullptr;
+    glfwGetError(&desc);
+    *error = std::string("cannot open a window (glfwInit failed: ") + (desc ? desc : "no display?") + ")";
+    return false;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_SAMPLES, opt_.msaa);
+  window_ = glfwCreateWindow(opt_.width, opt_.height, ("SimGrass - " + scenario().name).c_str(), nullptr, nullptr);
+  if (!window_) {
+    const char* desc = nullptr;
+    glfwGetError(&desc);
+    *error = std::string("cannot create an OpenGL 3.3 core window: ") + (desc ? desc : "unknown GLFW error");
+    return false;
+  }
+  glfwMakeContextCurrent(window_);
+  glfwSwapInterval(scripted_ ? 0 : 1);
+  glewExperimental = GL_TRUE;
+  const GLenum glew = glewInit();
+  if (glew != GLEW_OK) {
+    *error = std::string("glewInit failed: ") + reinterpret_cast<const char*>(glewGetErrorString(glew));
+    return false;
+  }
+  while (glGetError() != GL_NO_ERROR) {
+  }
+  glGetIntegerv(GL_SAMPLES, &samples_);
+  pinLoadedLibraries();
+  try {
+    renderer_ = std::make_unique<Renderer>();
+  } catch (const std::exception& e) {
+    *error = e.what();
+    return false;
+  }
+  if (!live_->scenarioDir.empty()) renderer_->setAssetDirectory(live_->scenarioDir);
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini next to the user's files
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(window_, true);
+  ImGui_ImplOpenGL3_Init("#version 330");
+  imgui_ = true;
+  return true;
+}
+
+void App::close() {
+  if (imgui_) {
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    imgui_ = false;
+  }
+  renderer_.reset();  // GL objects go while the context is current
+  if (window_) glfwDestroyWindow(window_);
+  window_ = nullptr;
+  glfwTerminate();
+}
+
+int App::finish(int code) {
+  if (live_->recorder) {
+    std::string e;
+    if (!live_->stopRecording(&e) && code == kExitOk) {
+      std::fprintf(stderr, "simgrass-viewer: %s\n", e.c_str());
+      code = kExitFailure;
+    }
+  }
+  std::printf("final      tick %" PRId64 ", hash %s\n", world().tick(), hex(world().stateHash()).c_str());
+  std::fflush(stdout);
+  close();
+  return code;
+}
+
+bool App::key(int k) const {
+  if (scripted_) return scriptKeys_[size_t(k)];
+  if (imgui_ && ImGui::GetIO().WantCaptureKeyboard) return false;
+  return glfwGetKey(window_, k) == GLFW_PRESS;
+}
+
+bool App::pressed(int k) {
+  const bool down = key(k);
+  const bool edge = down && !wasDown_[size_t(k)];
+  wasDown_[size_t(k)] = down;
+  return edge;
+}
+
+void App::showError(const std::string& message) {
+  std::fprintf(stderr, "simgrass-viewer: %s\n", message.c_str());
+  std::fflush(stderr);
+  errorText_ = message;
+}
+
+// ---- input ------------------------------------------------------------------------------------
+
+TickInput App::tickInput() {
+  TickInput in;
+  in.hasCamera = true;
+  in.camera = {toRaw(cam_.camera.x), toRaw(cam_.camera.y), toRaw(cam_.camera.z)};
+  // The scenario's own scripted commands still play (the thesis scene kicks the football); the
+  // user's commands come after them. Its camera track is replaced by the user's camera.
+  const Session& s = *live_;
+  if (!opt_.noScenarioInput) in.bodies = scriptedInput(s.scenario, s.world->tick()).bodies;
+  // One-shot commands (reset, spawn, mower) go into the first tick after the key.
+  in.bodies.insert(in.bodies.end(), pendingCommands_.begin(), pendingCommands_.end());
+  pendingCommands_.clear();
+  const int64_t bodies = s.world->counts().bodies;
+  if (selected_ < 0 || selected_ >= bodies) return in;
+  float fx, fz, rx, rz;
+  cam_.groundAxes(&fx, &fz, &rx, &rz);
+  const float f = float(key(GLFW_KEY_T)) - float(key(GLFW_KEY_G));
+  const float r = float(key(GLFW_KEY_H)) - float(key(GLFW_KEY_F));
+  const float u = float(key(GLFW_KEY_U)) - float(key(GLFW_KEY_J));
+  if (f == 0 && r == 0 && u == 0) return in;
+  const double dt = s.scenario.timeStep.toDouble();
+  const double scale = positionMode_ ? cam_.tune.bodySpeed * dt : cam_.tune.bodyAcceleration * dt;
+  BodyCommand c;
+  c.body = selected_;
+  c.kind = positionMode_ ? BodyCommandKind::Displace : BodyCommandKind::AddVelocity;
+  c.value = {toRaw((f * fx + r * rx) * scale), toRaw(u * scale), toRaw((f * fz + r * rz) * scale)};
+  in.bodies.push_back(c);
+  return in;
+}
+
+void App::queueBodyCommand(BodyCommandKind kind) {
+  const int64_t bodies = live_->world->counts().bodies;
+  if (play_ || selected_ < 0 || selected_ >= bodies) return;
+  BodyCommand c;
+  c.body = selected_;
+  c.kind = kind;
+  if (kind == BodyCommandKind::Spawn) {
+    if (bodies >= kMaxBodies) {
+      status_ = "at most " + std::to_string(kMaxBodies) + " bodies";
+      return;
+    }
+    // 3 m in front of the camera (on the ground plane), 1 m above the terrain there.
+    float fx, fz, rx, rz;
+    cam_.groundAxes(&fx, &fz, &rx, &rz);
+    const float x = cam_.camera.x + 3 * fx, z = cam_.camera.z + 3 * fz;
+    c.value = {toRaw(x), toRaw(groundHeight(world(), x, z) + 1.0), toRaw(z)};
+  }
+  if (kind == BodyCommandKind::MowerOn || kind == BodyCommandKind::MowerOff) {
+    if (mowerOn_.size() < size_t(bodies)) mowerOn_.resize(size_t(bodies), true);
+    mowerOn_[size_t(selected_)] = kind == BodyCommandKind::MowerOn;
+  }
+  pendingCommands_.push_back(c);
+}
+
+void App::handleToggles() {
+  std::string error;
+  if (pressed(GLFW_KEY_C)) cam_.free = !cam_.free;
+  if (pressed(GLFW_KEY_V) && play_ && play_->hasB()) abView_ = abView_ == AbView::Side ? AbView::Overlay : AbView::Side;
+  if (!scripted_ && pressed(GLFW_KEY_ESCAPE)) glfwSetWindowShouldClose(window_, GLFW_TRUE);
+  if (play_) {
+    if (pressed(GLFW_KEY_SPACE)) play_->playing = !play_->playing;
+    if (pressed(GLFW_KEY_PERIOD)) {
+      play_->playing = false;
+      if (!play_->step(1, &error)) showError(error);
+    }
+    if (pressed(GLFW_KEY_HOME) && !play_->seek(0, &error)) showError(error);
+    return;
+  }
+  const int64_t bodies = live_->world->counts().bodies;
+  if (pressed(GLFW_KEY_TAB) && bodies > 0) selected_ = int((selected_ + 1) % bodies);
+  if (pressed(GLFW_KEY_P)) positionMode_ = !positionMode_;
+  if (pressed(GLFW_KEY_M)) {
+    const bool on = size_t(selected_) < mowerOn_.size() ? mowerOn_[size_t(selected_)] : true;
+    queueBodyCommand(on ? BodyCommandKind::MowerOff : BodyCommandKind::MowerOn);
+  }
+  const bool backspace = pressed(GLFW_KEY_BACKSPACE), z = pressed(GLFW_KEY_Z);  // both edges tracked
+  if (backspace || z) queueBodyCommand(BodyCommandKind::Reset);
+  if (pressed(GLFW_KEY_N)) queueBodyCommand(BodyCommandKind::Spawn);
+  if (pressed(GLFW_KEY_R)) {
+    if (live_->recorder) {
+      status_ = live_->stopRecording(&error) ? "saved " + live_->recordPath : error;
+    } else {
+      const std::string path = "simgrass-" + live_->scenario.name + "-" +
+                               std::to_string(std::chrono::system_clock::now().time_since_epoch().count() / 1000000000) +
+                               ".sgr";
+      status_ = live_->startRecording(path, &error) ? "" : error;
+    }
+  }
+}
+
+// ---- simulation -------------------------------------------------------------------------------
+
+bool App::simulate(double wall, std::string* error) {
+  if (play_) {
+    // Playback: `wall` seconds are wall/dt recorded ticks at speed 1 (a scripted frame: one).
+    const double dt = play_->scenario().timeStep.toDouble();
+    if (!play_->advance(scripted_ ? 1.0 : std::min(wall, 0.25) / dt, error)) return false;
+    if (!play_->mismatchText().empty() && errorText_.empty()) errorText_ = play_->mismatchText();
+    return true;
+  }
+  const double dt = live_->scenario.timeStep.toDouble();
+  int steps = 1;
+  if (!scripted_) {
+    accumulator_ = std::min(accumulator_ + wall, 0.25);
+    steps = int(accumulator_ / dt);
+    accumulator_ -= steps * dt;
+    steps = std::min(steps, 8);
+  }
+  for (int i = 0; i < steps; ++i) {
+    // The tick before the last of this frame is what display interpolation starts from.
+    if (i + 1 == steps && interpolate_ && !scripted_) extractScene(world(), scenario(), &previous_);
+    const StepResult r = live_->step(tickInput());
+    if (!r.ok) {
+      *error = "the simulation faulted: " + r.error.message();
+      return false;
+    }
+    ++clockTicks_;
+  }
+  if (clockTicks_ >= 30) {
+    double total = 0;
+    for (size_t st = 0; st < size_t(Stage::Count); ++st) {
+      stageMs_[st] = double(live_->clock.nanos[st]) / 1e6 / double(clockTicks_);
+      total += stageMs_[st];
+      live_->clock.nanos[st] = 0;
+    }
+    simMsPerTick_ = total;
+    clockTicks_ = 0;
+  }
+  return true;
+}
+
+// ---- drawing ----------------------------------------------------------------------------------
+
+void App::buildScenes(float alpha) {
+  extractScene(world(), scenario(), &scene_);
+  if (render_.debug.any()) extractDebug(world(), scenario(), render_.debug, &scene_);
+  render_.heatMap = false;
+  if (play_ && play_->hasB()) {
+    if (abView_ == AbView::Side) {
+      extractScene(play_->worldB(), play_->scenarioB(), &sceneB_);
+      if (render_.debug.any()) extractDebug(play_->worldB(), play_->scenarioB(), render_.debug, &sceneB_);
+    } else if (play_->measured()) {
+      applyDivergenceHeat(play_->observationA(), play_->observationB(), heatFullScale_, &scene_);
+      render_.heatMap = true;
+    }
+  }
+  const bool lerp = interpolate_ && !scripted_ && !play_ && previous_.tick + 1 == scene_.tick;
+  if (lerp) interpolateScene(previous_, scene_, std::clamp(alpha, 0.0f, 1.0f), &shown_);
+}
+
+void App::renderWorld(int fbw, int fbh) {
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glViewport(0, 0, fbw, fbh);
+  RenderOptions o = render_;
+  o.alphaToCoverage = render_.alphaToCoverage && samples_ > 0;
+  const bool lerp = interpolate_ && !scripted_ && !play_ && previous_.tick + 1 == scene_.tick;
+  const Scene& a = lerp ? shown_ : scene_;
+  if (!(play_ && play_->hasB() && abView_ == AbView::Side)) {
+    renderer_->draw(a, cam_.camera, fbw, fbh, o);
+    return;
+  }
+  // Side by side, one camera: the renderer draws at the viewport origin and clears the whole
+  // framebuffer, so B goes first into the left half and is copied to the right; then A is drawn
+  // into the left half with the scissor keeping its clear off B.
+  const int half = fbw / 2;
+  RenderOptions ob = o;
+  ob.heatMap = false;
+  renderer_->draw(sceneB_, cam_.camera, half, fbh, ob);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glBlitFramebuffer(0, 0, half, fbh, fbw - half, 0, fbw, fbh, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(0, 0, half, fbh);
+  renderer_->draw(a, cam_.camera, half, fbh, o);
+  glDisable(GL_SCISSOR_TEST);
+  glViewport(0, 0, fbw, fbh);
+}
+
+bool App::screenshot(const std::string& path, std::string* error) {
+  int fbw = 0, fbh = 0;
+  glfwGetFramebufferSize(window_, &fbw, &fbh);
+  renderWorld(fbw, fbh);
+  // The panels of the last frame (ImGui's draw data stays valid until the next NewFrame).
+  if (imgui_ && ImGui::GetDrawData() && ImGui::GetDrawData()->Valid) ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  Image img;
+  img.width = fbw;
+  img.height = fbh;
+  img.rgba.assign(size_t(fbw) * size_t(fbh) * 4, 0);
+  std::vector<uint8_t> rows(img.rgba.size());
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadBuffer(GL_BACK);
+  glReadPixels(0, 0, fbw, fbh, GL_RGBA, GL_UNSIGNED_BYTE, rows.data());
+  const size_t stride = size_t(fbw) * 4;
+  for (int y = 0; y < fbh; ++y)
+    std::copy_n(rows.data() + size_t(fbh - 1 - y) * stride, stride, img.rgba.data() + size_t(y) * stride);
+  for (size_t i = 3; i < img.rgba.size(); i += 4) img.rgba[i] = 255;
+  return writePng(path, img, error);
+}
+
+int App::run(const std::vector<ScriptCommand>* script, const std::string& startupError) {
+  scripted_ = script != nullptr;
+  if (scripted_) interpolate_ = false;  // frame-locked runs show exact ticks (screenshots stay exact)
+  std::string error;
+  if (!open(&error)) {
+    close();
+    std::fprintf(stderr, "simgrass-viewer: %s\n", error.c_str());
+    return kExitFailure;
+  }
+  errorText_ = startupError;
+  extractScene(world(), scenario(), &scene_);
+  cam_.camera = defaultCamera(scene_, world());
+  cam_.eyeHeight = cam_.camera.y - groundHeight(world(), cam_.camera.x, cam_.camera.z);
+  render_.alphaToCoverage = samples_ > 0;
+  if (play_) play_->playing = !scripted_;  // interactive: starts playing; scripts start paused
+  if (!opt_.record.empty() && !live_->startRecording(opt_.record, &error)) {
+    std::fprintf(stderr, "simgrass-viewer: %s\n", error.c_str());
+    return finish(kExitFailure);
+  }
+
+  using Clock = std::chrono::steady_clock;
+  auto last = Clock::now();
+  int64_t pendingFrames = 0;
+  while (!glfwWindowShouldClose(window_)) {
+    if (scripted_) {
+      if (pendingFrames == 0) {
+        const int r = runScript(*script, &pendingFrames);
+        if (r != kGoOn) return finish(r);
+      }
+    } else if (opt_.frames >= 0 && frames_ >= opt_.frames) {
+      break;
+    }
+    glfwPollEvents();
+    if (imgui_) {
+      ImGui_ImplOpenGL3_NewFrame();
+      ImGui_ImplGlfw_NewFrame();
+      ImGui::NewFrame();
+    }
+    const auto now = Clock::now();
+    const double wall = std::chrono::duration<double>(now - last).count();
+    last = now;
+    frameMs_ = 0.9 * frameMs_ + 0.1 * wall * 1e3;
+
+    // Mouse look while the right button is held (interactive only).
+    if (!scripted_) {
+      double cx = 0, cy = 0;
+      glfwGetCursorPos(window_, &cx, &cy);
+      const bool held = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS &&
+                        !(ImGui::GetIO().WantCaptureMouse && !looking_);
+      if (held && looking_) cam_.look(float(cx - lastCursorX_), float(cy - lastCursorY_));
+      looking_ = held;
+      lastCursorX_ = cx;
+      lastCursorY_ = cy;
+    }
+    handleToggles();
+    const double dt = scenario().timeStep.toDouble();
+    MoveKeys mk;
+    mk.forward = float(key(GLFW_KEY_W)) - float(key(GLFW_KEY_S));
+    mk.right = float(key(GLFW_KEY_D)) - float(key(GLFW_KEY_A));
+    mk.up = float(key(GLFW_KEY_E)) - float(key(GLFW_KEY_Q));
+    mk.fast = key(GLFW_KEY_LEFT_SHIFT);
+    cam_.update(mk, scripted_ ? float(dt) : float(wall), ground());
+    if (!simulate(wall, &error)) {
+      std::fprintf(stderr, "simgrass-viewer: %s\n", error.c_str());
+      return finish(kExitFailure);
+    }
+
+    buildScenes(float(accumulator_ / dt));
+    int fbw = 0, fbh = 0;
+    glfwGetFramebufferSize(window_, &fbw, &fbh);
+    if (fbw > 0 && fbh > 0) {
+      const auto r0 = Clock::now();
+      renderWorld(fbw, fbh);
+      glFinish();
+      renderMs_ = 0.9 * renderMs_ + 0.1 * std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
+    }
+    if (imgui_) {
+      drawPanels();
+      ImGui::Render();
+      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    }
+    glfwSwapBuffers(window_);
+    ++frames_;
+    if (pendingFrames > 0) --pendingFrames;
+  }
+  return finish(kExitOk);
+}
+
+}  // namespace sg::viewer

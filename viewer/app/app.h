@@ -1,0 +1,153 @@
+// The window and the frame loop of simgrass-viewer (docs/viewer.md): a GLFW window (OpenGL 3.3
+// core, GLEW), the shared Renderer, Dear ImGui panels (panels.cpp), and one of two sources of
+// worlds: a live Session (keys and camera become recorded TickInputs) or a Playback of a `.sgr`
+// (optionally A/B against a second run).
+//
+// The simulation never reads a clock: the loop decides how many ticks to run (a fixed-step
+// accumulator at the scenario's dt, or exactly one per frame with --script) and hands each one a
+// TickInput, which is all a recording needs to reproduce the session.
+#pragma once
+
+#include <GL/glew.h>
+// GLEW's header first; GLFW must not pull in another GL header.
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "viewer/app/camera_controller.h"
+#include "viewer/app/options.h"
+#include "viewer/app/playback.h"
+#include "viewer/app/script.h"
+#include "viewer/app/session.h"
+#include "viewer/render/renderer.h"
+#include "viewer/render/scene.h"
+
+namespace sg::viewer {
+
+/// App::runScript / runCommand: go on (any other value is an exit code).
+inline constexpr int kGoOn = -1;
+
+/// Panel edit buffers (what the Physics, Grass, Meadow and Terrain panels show before Apply).
+struct ScenarioEdits {
+  float gustScale = 1, gustPeriodScale = 1;  ///< factors on the wind schedule's forces / durations
+  float damping = 0.97f, upAcceleration = 1, constraintLength = 1;
+  float gravityY = -9.81f;
+  float scaleY = 1, scaleXZ = 0.5f;
+  int patchesX = 151, patchesZ = 151, interpolation = 1;
+  float spacing = 0.25f;
+  char heightmap[512] = "";
+  float cellSize = 1, maxHeight = 5;
+};
+
+class App {
+ public:
+  /// Starts with a live session, or with a playback when `playback` is given (then `live` is the
+  /// built-in meadow, kept for the Open panel's errors to fall back on).
+  App(Options o, std::unique_ptr<Session> live, std::unique_ptr<Playback> playback);
+  /// `startupError`: shown in the error window from the first frame (--keep-open-on-error).
+  int run(const std::vector<ScriptCommand>* script, const std::string& startupError = "");
+
+ private:
+  enum class AbView { Side, Overlay };
+
+  // ---- app.cpp: window, loop, input ----
+  bool open(std::string* error);
+  void close();
+  int finish(int code);
+  bool key(int k) const;
+  bool pressed(int k);  ///< went down since the last frame
+  // ---- app_script.cpp ----
+  /// Runs script commands until one asks for frames (*frames = N); returns an exit code to stop
+  /// with, or -1 to render those frames.
+  int runScript(const std::vector<ScriptCommand>& script, int64_t* frames);
+  int runCommand(const ScriptCommand& c);
+  void handleToggles();
+  /// Advances the simulation for `wall` seconds of wall time (scripted: one tick). False: fault.
+  bool simulate(double wall, std::string* error);
+  TickInput tickInput();
+  void queueBodyCommand(BodyCommandKind kind);
+  void buildScenes(float alpha);
+  void renderWorld(int fbw, int fbh);
+  bool screenshot(const std::string& path, std::string* error);
+  void printState() const;
+  std::function<float(float, float)> ground();
+
+  // ---- files and sessions (app_files.cpp) ----
+  /// Opens a scenario or a recording in place of the current one. On failure keeps the current
+  /// session, prints the one-line error (the CLI's text) and shows it in the error window.
+  bool openFile(const std::string& path);
+  /// Applies scenario JSON edits by building a new Session (see docs/viewer.md: from tick 0, or
+  /// replaying the inputs so far when `replayHistory`). On failure the old session keeps running.
+  bool applyScenario(const std::string& text, bool replayHistory, const std::string& what);
+  void showError(const std::string& message);
+  void resetEdits();
+  std::string editedScenarioText() const;
+
+  // ---- panels.cpp ----
+  void drawPanels();
+  void panelStats();
+  void panelPlayback();
+  void panelAb();
+  void panelOpen();
+  void panelCamera();
+  void panelPhysics();
+  void panelVisuals();
+  void panelLod();
+  void panelMeadow();
+  void panelTerrain();
+  void panelBodies();
+  void panelRecording();
+  void errorWindow();
+
+  SimWorld& world() { return play_ ? play_->world() : *live_->world; }
+  const SimWorld& world() const { return play_ ? play_->world() : *live_->world; }
+  const Scenario& scenario() const { return play_ ? play_->scenario() : live_->scenario; }
+
+  Options opt_;
+  std::unique_ptr<Session> live_;
+  std::unique_ptr<Playback> play_;
+  CameraController cam_;
+  GLFWwindow* window_ = nullptr;
+  bool imgui_ = false;
+  std::unique_ptr<Renderer> renderer_;
+  Scene scene_, sceneB_, previous_, shown_;
+  bool scripted_ = false;
+  std::array<bool, GLFW_KEY_LAST + 1> scriptKeys_{};
+  std::array<bool, GLFW_KEY_LAST + 1> wasDown_{};
+  int samples_ = 0;
+  double lastCursorX_ = 0, lastCursorY_ = 0;
+  bool looking_ = false;
+  double accumulator_ = 0;  ///< s of wall time not yet simulated (live, interactive)
+  // Bodies.
+  int selected_ = 0;
+  bool positionMode_ = false;
+  std::vector<bool> mowerOn_;                ///< per body; mowers start cutting
+  std::vector<BodyCommand> pendingCommands_; ///< one-shot commands (reset, spawn, mower) for the next tick
+  // Visuals.
+  RenderOptions render_;
+  bool interpolate_ = true;      ///< display interpolation (off in scripted runs)
+  float heatFullScale_ = 0.05f;  ///< m of tip difference shown at full heat
+  AbView abView_ = AbView::Side;
+  // Panels.
+  ScenarioEdits edits_;
+  char openPath_[512] = "";
+  bool scrubbing_ = false;  ///< the timeline slider is held
+  int64_t scrubTick_ = 0;   ///< where it is held
+  std::string errorText_;  ///< the error window's line ("" when closed)
+  std::string status_;
+  // Stats.
+  double renderMs_ = 0, frameMs_ = 0;
+  std::array<double, size_t(Stage::Count)> stageMs_{};
+  double simMsPerTick_ = 0;
+  int64_t clockTicks_ = 0;
+  int64_t frames_ = 0;
+  std::string scriptWhere_;  ///< "FILE:LINE: " of the running script command
+  size_t scriptNext_ = 0;    ///< next script command
+  std::string stagedText_;   ///< scenario text edited by `set`, applied by `regenerate`
+};
+
+}  // namespace sg::viewer

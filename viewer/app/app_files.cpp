@@ -1,0 +1,134 @@
+// Opening files and applying panel edits: a scenario or recording replaces what runs, or the
+// edited scenario text becomes a new Session. Failures keep the old session and show the CLI's
+// one-line error (stderr and the Error window).
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "viewer/app/app.h"
+
+namespace sg::viewer {
+
+// ---- files and sessions ---------------------------------------------------------------------
+
+bool App::openFile(const std::string& path) {
+  try {
+    if (looksLikeRecording(path)) {
+      std::unique_ptr<Playback> p = Playback::open(path, opt_.threads);
+      play_ = std::move(p);
+      play_->playing = !scripted_;  // interactive: starts playing; scripts start paused (exact ticks)
+      status_ = "playing " + path;
+    } else {
+      std::unique_ptr<Session> s = Session::load(path, opt_.threads);
+      if (live_->recorder) {
+        std::string e;
+        if (!live_->stopRecording(&e)) showError(e);
+      }
+      live_ = std::move(s);
+      play_.reset();
+      if (renderer_ && !live_->scenarioDir.empty()) renderer_->setAssetDirectory(live_->scenarioDir);
+      status_ = "opened " + path;
+    }
+  } catch (const std::exception& e) {  // RecordingError, ScenarioError: the CLI's one line
+    showError(e.what());
+    return false;
+  }
+  selected_ = 0;
+  mowerOn_.clear();
+  pendingCommands_.clear();
+  accumulator_ = 0;
+  errorText_.clear();
+  resetEdits();
+  extractScene(world(), scenario(), &scene_);
+  cam_.camera = defaultCamera(scene_, world());
+  cam_.eyeHeight = cam_.camera.y - groundHeight(world(), cam_.camera.x, cam_.camera.z);
+  return true;
+}
+
+void App::resetEdits() {
+  const Scenario& s = live_->scenario;
+  ScenarioEdits e;
+  e.damping = float(s.particles.damping.toDouble());
+  e.upAcceleration = float(s.particles.acceleration[1].toDouble());
+  e.constraintLength = float(s.particles.constraintLength.toDouble());
+  e.gravityY = float(s.bodies.gravity[1].toDouble());
+  e.scaleY = float(s.field.scaleY.toDouble());
+  e.scaleXZ = float(s.field.scaleXZ.toDouble());
+  e.patchesX = int(s.field.patchesX);
+  e.patchesZ = int(s.field.patchesZ);
+  e.interpolation = s.particles.interpolation;
+  e.spacing = float(s.field.spacing.toDouble());
+  e.cellSize = float(s.terrain.cellSize.toDouble());
+  e.maxHeight = float(s.terrain.maxHeight.toDouble());
+  std::snprintf(e.heightmap, sizeof e.heightmap, "%s", s.terrain.heightmapPath.c_str());
+  edits_ = e;
+}
+
+/// The live scenario's JSON with the panels' values written in. Numbers go in as decimal text
+/// rounded to 6 significant digits, which the scenario parser reads exactly (Rational).
+std::string App::editedScenarioText() const {
+  nlohmann::json j = nlohmann::json::parse(live_->scenario.text, nullptr, false);
+  if (!j.is_object()) j = nlohmann::json::object();
+  auto round6 = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return nlohmann::json::parse(buf);
+  };
+  const Scenario& s = live_->scenario;
+  j["particles"]["damping"] = round6(edits_.damping);
+  j["particles"]["acceleration"] = {round6(s.particles.acceleration[0].toDouble()), round6(edits_.upAcceleration),
+                                    round6(s.particles.acceleration[2].toDouble())};
+  j["particles"]["constraintLength"] = round6(edits_.constraintLength);
+  j["particles"]["interpolation"] = edits_.interpolation;
+  j["bodies"]["gravity"] = {round6(s.bodies.gravity[0].toDouble()), round6(edits_.gravityY),
+                            round6(s.bodies.gravity[2].toDouble())};
+  j["field"]["scaleY"] = round6(edits_.scaleY);
+  j["field"]["scaleXZ"] = round6(edits_.scaleXZ);
+  j["field"]["patchesX"] = edits_.patchesX;
+  j["field"]["patchesZ"] = edits_.patchesZ;
+  j["field"]["spacing"] = round6(edits_.spacing);
+  if (edits_.gustScale != 1 || edits_.gustPeriodScale != 1) {
+    nlohmann::json schedule = nlohmann::json::array();
+    for (const WindGust& g : s.wind.schedule)
+      schedule.push_back({{"force",
+                           {round6(g.force[0].toDouble() * edits_.gustScale), round6(g.force[1].toDouble() * edits_.gustScale),
+                            round6(g.force[2].toDouble() * edits_.gustScale)}},
+                          {"duration", round6(g.duration.toDouble() * edits_.gustPeriodScale)}});
+    j["wind"]["schedule"] = schedule;
+  }
+  if (edits_.heightmap[0] && edits_.heightmap != s.terrain.heightmapPath)
+    j["terrain"] = {{"type", "heightmap"},
+                    {"file", std::string(edits_.heightmap)},
+                    {"cellSize", round6(edits_.cellSize)},
+                    {"maxHeight", round6(edits_.maxHeight)}};
+  return j.dump(2);
+}
+
+bool App::applyScenario(const std::string& text, bool replayHistory, const std::string& what) {
+  std::unique_ptr<Session> next;
+  try {
+    next = live_->rebuilt(text, replayHistory);
+  } catch (const std::exception& e) {
+    showError(e.what());
+    return false;
+  }
+  std::string note;
+  if (live_->recorder) {
+    // The recording's scenario text no longer describes the session: end it where it stands.
+    std::string e;
+    if (live_->stopRecording(&e)) note = "; the recording " + live_->recordPath + " was stopped";
+    else showError(e);
+  }
+  play_.reset();
+  live_ = std::move(next);
+  status_ = what + (replayHistory ? " (inputs so far replayed)" : " (new world from tick 0)") + note;
+  std::printf("%s\n", status_.c_str());
+  std::fflush(stdout);
+  errorText_.clear();
+  mowerOn_.clear();
+  pendingCommands_.clear();
+  if (selected_ >= live_->world->counts().bodies) selected_ = 0;
+  resetEdits();
+  return true;
+}
+
+}  // namespace sg::viewer

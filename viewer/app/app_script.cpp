@@ -1,0 +1,135 @@
+// Script commands (--script, docs/viewer.md): each one does what a key or a panel does, so tests
+// drive the same code paths; `print` is the line tests compare with the CLI.
+#include <cinttypes>
+#include <cstdio>
+
+#include "viewer/app/app.h"
+#include "viewer/app/text.h"
+
+namespace sg::viewer {
+
+/// The `print` line: what tests compare with the CLI (state hash at a tick, counts, A/B numbers).
+void App::printState() const {
+  const WorldCounts c = world().counts();
+  std::printf("state      tick %" PRId64 ", hash %s, patches %" PRId64 "x%" PRId64 ", bodies %" PRId64,
+              world().tick(), hex(world().stateHash()).c_str(), c.patchesX, c.patchesZ, c.bodies);
+  if (play_) {
+    std::printf(", playback %" PRId64 "/%" PRId64 ", hashes ok %" PRId64 ", mismatch %" PRId64, play_->tick(),
+                play_->lastTick(), play_->hashesOk(), play_->firstMismatchTick());
+    if (play_->hasB())
+      std::printf(", ab tick %" PRId64 ", tipMax %.9g m, tipRms %.9g m, first divergent tick %" PRId64, play_->tickB(),
+                  play_->measured() ? play_->divergence().tipMax : -1.0,
+                  play_->measured() ? play_->divergence().tipRms : -1.0, play_->firstDivergentTick());
+  }
+  std::printf("\n");
+  std::fflush(stdout);
+}
+
+// ---- script -----------------------------------------------------------------------------------
+
+int App::runCommand(const ScriptCommand& c) {
+  const std::string& where = scriptWhere_;
+  std::string error;
+  auto failWith = [&](int code, const std::string& what) {
+    std::fprintf(stderr, "simgrass-viewer: %s%s\n", where.c_str(), what.c_str());
+    return code;
+  };
+  auto bad = [&](const std::string& what) { return failWith(kExitBadInput, what); };
+  auto needPlayback = [&](const char* cmd) {
+    return bad(std::string(cmd) + ": expected a recording to play back (open a .sgr), the viewer runs a live session");
+  };
+  using K = ScriptCommand::Kind;
+  switch (c.kind) {
+    case K::Frames: return kGoOn;  // handled by the caller
+    case K::Key: scriptKeys_[size_t(c.key)] = c.down; return kGoOn;
+    case K::Camera: cam_.place(c.camera[0], c.camera[1], c.camera[2], c.camera[3], c.camera[4], ground()); return kGoOn;
+    case K::Select:
+      if (c.count >= world().counts().bodies)
+        return bad("select " + std::to_string(c.count) + ": the scenario has " + std::to_string(world().counts().bodies) +
+                   " bodies");
+      selected_ = int(c.count);
+      return kGoOn;
+    case K::RecordStart:
+      if (play_) return bad("record start: a playback is not recorded again");
+      if (!live_->startRecording(c.path, &error)) return failWith(kExitFailure, error);
+      return kGoOn;
+    case K::RecordStop:
+      if (!live_->stopRecording(&error)) return failWith(kExitFailure, error);
+      return kGoOn;
+    case K::Screenshot:
+      if (!screenshot(c.path, &error)) return failWith(kExitFailure, error);
+      return kGoOn;
+    case K::Quit: return kExitOk;
+    case K::Play:
+    case K::Pause:
+      if (!play_) return needPlayback(c.kind == K::Play ? "play" : "pause");
+      play_->playing = c.kind == K::Play;
+      return kGoOn;
+    case K::Step:
+      if (!play_) return needPlayback("step");
+      play_->playing = false;
+      if (!play_->step(c.count, &error)) showError(error);
+      return kGoOn;
+    case K::Seek:
+      if (!play_) return needPlayback("seek");
+      if (c.count > play_->lastTick())
+        return bad("seek " + std::to_string(c.count) + ": expected a tick from 0 to " + std::to_string(play_->lastTick()));
+      if (!play_->seek(c.count, &error)) showError(error);
+      return kGoOn;
+    case K::Speed:
+      if (!play_) return needPlayback("speed");
+      play_->speed = c.number;
+      return kGoOn;
+    case K::AbView:
+      if (!play_ || !play_->hasB()) return bad("ab: expected A/B mode (--ab B.sgr or --ab-variant SETTINGS)");
+      abView_ = c.count ? AbView::Overlay : AbView::Side;
+      return kGoOn;
+    case K::Open: openFile(c.path); return kGoOn;  // a bad file: the error shown, the session goes on
+    case K::Set:
+      try {
+        // Staged like a panel edit: the next `regenerate` builds the world from it.
+        stagedText_ = editScenarioText(stagedText_.empty() ? live_->scenario.text : stagedText_,
+                                       live_->scenario.sourceName, c.path, c.value);
+      } catch (const std::exception& e) {
+        return bad(e.what());
+      }
+      return kGoOn;
+    case K::Regenerate:
+    {
+      const std::string text = stagedText_.empty() ? live_->scenario.text : stagedText_;
+      stagedText_.clear();
+      applyScenario(text, false, "regenerated");  // a bad edit: the error shown, the session goes on
+      return kGoOn;
+    }
+    case K::Lod: {
+      std::string text;
+      try {
+        text = editScenarioText(live_->scenario.text, live_->scenario.sourceName, "lod.mode",
+                                c.count ? "\"window\"" : "\"off\"");
+      } catch (const std::exception& e) {
+        return bad(e.what());
+      }
+      applyScenario(text, true, c.count ? "level of detail on" : "level of detail off");
+      return kGoOn;
+    }
+    case K::Print: printState(); return kGoOn;
+  }
+  return kGoOn;
+}
+
+int App::runScript(const std::vector<ScriptCommand>& script, int64_t* frames) {
+  while (true) {
+    if (scriptNext_ >= script.size()) return kExitOk;  // the end of the script quits
+    const ScriptCommand& c = script[scriptNext_++];
+    scriptWhere_ = opt_.script + ":" + std::to_string(c.line) + ": ";
+    if (c.kind == ScriptCommand::Kind::Frames) {
+      *frames = c.count;
+      if (c.count > 0) return kGoOn;
+      continue;
+    }
+    const int code = runCommand(c);
+    if (code != kGoOn) return code;
+  }
+}
+
+}  // namespace sg::viewer

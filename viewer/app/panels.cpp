@@ -1,0 +1,250 @@
+// The ImGui panels (the thesis GUI): stats with per-stage timings, open, playback and A/B, camera,
+// physics, grass scale, visuals, level of detail, meadow, terrain, bodies, recording, and the
+// error window. Panels never write into a running world: simulation edits build a new Session
+// from the edited scenario text (App::applyScenario), one-shot body actions become recorded inputs.
+#include <imgui.h>
+
+#include <cinttypes>
+#include <cstdio>
+
+#include "viewer/app/app.h"
+#include "viewer/app/text.h"
+
+namespace sg::viewer {
+
+void App::drawPanels() {
+  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
+  ImGui::Begin("SimGrass");
+  panelStats();
+  panelOpen();
+  if (play_) {
+    panelPlayback();
+    if (play_->hasB()) panelAb();
+  }
+  panelCamera();
+  panelVisuals();
+  if (!play_) {
+    panelPhysics();
+    panelLod();
+    panelMeadow();
+    panelTerrain();
+    panelBodies();
+    panelRecording();
+  }
+  if (!status_.empty()) ImGui::TextWrapped("%s", status_.c_str());
+  ImGui::End();
+  errorWindow();
+}
+
+void App::panelStats() {
+  if (!ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  ImGui::Text("%s, tick %" PRId64 " (%.2f s)", scenario().name.c_str(), world().tick(),
+              double(world().tick()) * scenario().timeStep.toDouble());
+  ImGui::Text("frame %.1f ms, render %.1f ms (%zu tufts)", frameMs_, renderMs_, scene_.tufts.size());
+  if (!play_) {
+    ImGui::Text("simulation %.2f ms/tick", simMsPerTick_);
+    for (size_t st = 0; st < size_t(Stage::Count); ++st)
+      ImGui::Text("  %-12s %.3f ms", stageName(Stage(st)), stageMs_[st]);
+  }
+  ImGui::Text("hash %s", hex(world().stateHash()).c_str());
+}
+
+void App::panelOpen() {
+  if (!ImGui::CollapsingHeader("Open")) return;
+  ImGui::InputText("path", openPath_, sizeof openPath_);
+  if (ImGui::Button("Open")) openFile(openPath_);
+  ImGui::SameLine();
+  ImGui::TextDisabled("scenario .json or recording .sgr");
+}
+
+void App::panelPlayback() {
+  if (!ImGui::CollapsingHeader("Playback", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  std::string error;
+  ImGui::Text("%s", play_->recording().file.c_str());
+  ImGui::Text("tick %" PRId64 " / %" PRId64, play_->tick(), play_->lastTick());
+  if (ImGui::Button(play_->playing ? "Pause (Space)" : "Play (Space)")) play_->playing = !play_->playing;
+  ImGui::SameLine();
+  if (ImGui::Button("Step (.)")) {
+    play_->playing = false;
+    if (!play_->step(1, &error)) showError(error);
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("Restart (Home)") && !play_->seek(0, &error)) showError(error);
+  // The timeline seeks when the slider is let go (a seek may replay up to a snapshot interval).
+  int64_t t = scrubbing_ ? scrubTick_ : play_->tick();
+  const int64_t lo = play_->recording().header.startTick, hi = play_->lastTick();
+  ImGui::SliderScalar("timeline", ImGuiDataType_S64, &t, &lo, &hi);
+  scrubbing_ = ImGui::IsItemActive();
+  scrubTick_ = t;
+  if (ImGui::IsItemDeactivatedAfterEdit() && !play_->seek(t, &error)) showError(error);
+  static const float speeds[] = {0.25f, 0.5f, 1, 2, 4, 8};
+  static const char* names[] = {"0.25x", "0.5x", "1x", "2x", "4x", "8x"};
+  int current = 2;
+  for (int i = 0; i < 6; ++i)
+    if (double(speeds[i]) == play_->speed) current = i;
+  if (ImGui::Combo("speed", &current, names, 6)) play_->speed = speeds[current];
+  if (!play_->hashesComparable()) {
+    ImGui::TextDisabled("hashes: not comparable (other settings)");
+  } else if (play_->firstMismatchTick() >= 0) {
+    ImGui::TextColored(ImVec4(1, 0.25f, 0.25f, 1), "hash MISMATCH at tick %" PRId64, play_->firstMismatchTick());
+    ImGui::TextColored(ImVec4(1, 0.25f, 0.25f, 1), "%" PRId64 " hashes checked OK", play_->hashesOk());
+  } else {
+    ImGui::TextColored(ImVec4(0.4f, 1, 0.4f, 1), "%" PRId64 " recorded hashes checked OK", play_->hashesOk());
+  }
+}
+
+void App::panelAb() {
+  if (!ImGui::CollapsingHeader("A/B", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  ImGui::TextWrapped("B: %s", play_->labelB().c_str());
+  int view = abView_ == AbView::Side ? 0 : 1;
+  ImGui::RadioButton("side by side", &view, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("divergence overlay (V)", &view, 1);
+  abView_ = view == 0 ? AbView::Side : AbView::Overlay;
+  if (abView_ == AbView::Overlay) ImGui::SliderFloat("full scale m", &heatFullScale_, 0.001f, 1.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
+  if (play_->measured()) {
+    const TickDivergence& d = play_->divergence();
+    ImGui::Text("tick %" PRId64 ": tip max %.3g m, RMS %.3g m", d.tick, d.tipMax, d.tipRms);
+    ImGui::Text("bodies: %.3g m, %.3g rad%s", d.bodyPosMax, d.bodyAngleMax, d.identical ? " (identical state)" : "");
+  } else {
+    ImGui::TextDisabled("B is between steps (coarser time step)");
+  }
+  if (play_->firstDivergentTick() >= 0)
+    ImGui::Text("first divergent tick so far: %" PRId64, play_->firstDivergentTick());
+  else
+    ImGui::Text("no divergence so far");
+}
+
+void App::panelCamera() {
+  if (!ImGui::CollapsingHeader("Camera", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  Camera& c = cam_.camera;
+  ImGui::Text("position %.2f %.2f %.2f m", c.x, c.y, c.z);
+  ImGui::Text("yaw %.1f, pitch %.1f degrees", c.yawDegrees, c.pitchDegrees);
+  ImGui::Checkbox("free camera (C)", &cam_.free);
+  ImGui::SliderFloat("speed m/s", &cam_.tune.walkSpeed, 0.5f, 40.0f);
+  if (!cam_.free) ImGui::SliderFloat("eye height", &cam_.eyeHeight, cam_.tune.minEyeHeight, 50.0f);
+  if (play_) ImGui::TextDisabled("the recorded camera drives the level of detail");
+}
+
+void App::panelPhysics() {
+  if (ImGui::CollapsingHeader("Physics")) {
+    ImGui::SliderFloat("gust strength x", &edits_.gustScale, 0.0f, 4.0f);
+    ImGui::SliderFloat("gust period x", &edits_.gustPeriodScale, 0.25f, 4.0f);
+    ImGui::SliderFloat("damping /s", &edits_.damping, 0.5f, 1.0f, "%.3f");
+    ImGui::SliderFloat("stiffness (up m/s2)", &edits_.upAcceleration, 0.0f, 5.0f);
+    ImGui::SliderFloat("rod length m", &edits_.constraintLength, 0.2f, 3.0f);
+    ImGui::SliderFloat("gravity y m/s2", &edits_.gravityY, -30.0f, 0.0f);
+    if (ImGui::Button("Apply physics")) applyScenario(editedScenarioText(), false, "physics applied");
+  }
+  if (ImGui::CollapsingHeader("Grass scale")) {
+    ImGui::SliderFloat("tuft height m", &edits_.scaleY, 0.1f, 3.0f);
+    ImGui::SliderFloat("tuft half width m", &edits_.scaleXZ, 0.05f, 2.0f);
+    if (ImGui::Button("Apply scale")) applyScenario(editedScenarioText(), false, "grass scale applied");
+  }
+  ImGui::TextDisabled("(applying builds a new world from tick 0)");
+}
+
+void App::panelVisuals() {
+  if (!ImGui::CollapsingHeader("Visuals")) return;
+  if (samples_ > 0) {
+    ImGui::Checkbox("alpha to coverage (else alpha test)", &render_.alphaToCoverage);
+  } else {
+    ImGui::TextDisabled("alpha test (no MSAA: --msaa 2|4|8)");
+  }
+  ImGui::Checkbox("SSAO", &render_.ssao);
+  ImGui::Checkbox("rock blend", &render_.rockBlend);
+  ImGui::Checkbox("interpolate between ticks", &interpolate_);
+  ImGui::Text("debug overlay:");
+  ImGui::Checkbox("particles", &render_.debug.particles);
+  ImGui::SameLine();
+  ImGui::Checkbox("constraints", &render_.debug.constraints);
+  ImGui::Checkbox("primitives", &render_.debug.primitives);
+  ImGui::SameLine();
+  ImGui::Checkbox("cells", &render_.debug.cells);
+  ImGui::SameLine();
+  ImGui::Checkbox("contacts", &render_.debug.contacts);
+}
+
+void App::panelLod() {
+  if (!ImGui::CollapsingHeader("Level of detail")) return;
+  const WorldCounts counts = world().counts();
+  if (counts.lodWindow)
+    ImGui::Text("on: window %" PRId64 " x %" PRId64 " patches of %" PRId64 " x %" PRId64, counts.windowPatchesX,
+                counts.windowPatchesZ, counts.patchesX, counts.patchesZ);
+  else
+    ImGui::Text("off: all %" PRId64 " x %" PRId64 " patches simulated", counts.patchesX, counts.patchesZ);
+  bool follows = counts.lodWindow;
+  if (ImGui::Checkbox("grass follows camera", &follows)) {
+    try {
+      applyScenario(editScenarioText(live_->scenario.text, live_->scenario.sourceName, "lod.mode",
+                                     follows ? "\"window\"" : "\"off\""),
+                    true, follows ? "level of detail on" : "level of detail off");
+    } catch (const std::exception& e) {
+      showError(e.what());
+    }
+  }
+  ImGui::TextDisabled("(rebuilds the world and replays the inputs so far)");
+}
+
+void App::panelMeadow() {
+  if (!ImGui::CollapsingHeader("Meadow")) return;
+  ImGui::InputInt("patches x", &edits_.patchesX);
+  ImGui::InputInt("patches z", &edits_.patchesZ);
+  ImGui::SliderFloat("spacing m", &edits_.spacing, 0.05f, 2.0f);
+  ImGui::SliderInt("interpolation k", &edits_.interpolation, 1, 4);
+  if (ImGui::Button("Regenerate")) applyScenario(editedScenarioText(), false, "meadow regenerated");
+}
+
+void App::panelTerrain() {
+  if (!ImGui::CollapsingHeader("Terrain")) return;
+  ImGui::InputText("heightmap PNG", edits_.heightmap, sizeof edits_.heightmap);
+  ImGui::SliderFloat("cell size m", &edits_.cellSize, 0.1f, 10.0f);
+  ImGui::SliderFloat("max height m", &edits_.maxHeight, 0.0f, 50.0f);
+  if (ImGui::Button("Load")) applyScenario(editedScenarioText(), false, "terrain loaded");
+}
+
+void App::panelBodies() {
+  if (!ImGui::CollapsingHeader("Bodies", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  const int64_t bodies = world().counts().bodies;
+  if (bodies == 0) {
+    ImGui::Text("none");
+    return;
+  }
+  const auto& list = live_->scenario.bodies.list;
+  const std::string name = size_t(selected_) < list.size() ? list[size_t(selected_)].name : std::string("spawned");
+  ImGui::Text("selected %d/%" PRId64 ": %s (Tab)", selected_, bodies, name.c_str());
+  ImGui::Text("mode: %s (P)", positionMode_ ? "position (Displace)" : "velocity (AddVelocity)");
+  ImGui::Text("drive: T/F/G/H, up/down: U/J");
+  const bool on = size_t(selected_) < mowerOn_.size() ? mowerOn_[size_t(selected_)] : true;
+  if (ImGui::Button(on ? "Mower off (M)" : "Mower on (M)"))
+    queueBodyCommand(on ? BodyCommandKind::MowerOff : BodyCommandKind::MowerOn);
+  ImGui::SameLine();
+  if (ImGui::Button("Reset (Z)")) queueBodyCommand(BodyCommandKind::Reset);
+  ImGui::SameLine();
+  if (ImGui::Button("Spawn (N)")) queueBodyCommand(BodyCommandKind::Spawn);
+}
+
+void App::panelRecording() {
+  if (!ImGui::CollapsingHeader("Recording", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (live_->recorder)
+    ImGui::Text("recording to %s\n%.1f KiB (R stops)", live_->recordPath.c_str(),
+                double(live_->recorder->bytesWritten()) / 1024.0);
+  else
+    ImGui::Text("not recording (R starts)");
+}
+
+void App::errorWindow() {
+  if (errorText_.empty()) return;
+  ImGui::SetNextWindowPos(ImVec2(360, 10), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(420, 0), ImGuiCond_FirstUseEver);
+  bool open = true;
+  ImGui::Begin("Error", &open);
+  ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.35f, 0.35f, 1));
+  ImGui::TextWrapped("%s", errorText_.c_str());
+  ImGui::PopStyleColor();
+  ImGui::End();
+  if (!open) errorText_.clear();
+}
+
+}  // namespace sg::viewer

@@ -1,0 +1,95 @@
+// Playing a recording in the window: play/pause, single steps, seeking through snapshots
+// (Player::seek), a speed factor, the recorded hashes checked as the ticks go by, and an optional
+// B side for A/B comparison (a second recording, or the same one re-simulated under a variant via
+// LockStepReplay) measured against A on every common tick.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <set>
+#include <string>
+
+#include "replay/divergence.h"
+#include "replay/lockstep.h"
+#include "replay/player.h"
+
+namespace sg::viewer {
+
+/// True for a path ending in ".sgr" or a file starting with the recording magic.
+bool looksLikeRecording(const std::string& path);
+
+class Playback {
+ public:
+  /// Reads and opens a recording. Throws sgr::RecordingError, whose message is the line the CLI
+  /// prints (`simgrass replay FILE` shows the same text after its "simgrass replay: ").
+  static std::unique_ptr<Playback> open(const std::string& path, int threads);
+
+  /// A/B: B is a second recording (same time step as A) ...
+  void attachRecording(const std::string& path);
+  /// ... or A's recording re-simulated under `variant` ("interp=2", "dt=1/120"). Both throw
+  /// sgr::RecordingError or std::invalid_argument with a one-line message.
+  void attachVariant(const std::string& variant);
+
+  const sgr::Recording& recording() const { return *rec_; }
+  SimWorld& world() { return player_->world(); }
+  const Scenario& scenario() const { return player_->scenario(); }
+  int64_t tick() const { return player_->tick(); }
+  int64_t lastTick() const { return rec_->lastTick(); }
+
+  bool playing = false;
+  double speed = 1;  ///< recorded ticks per tick of wall-clock time (0.25 ... 8)
+
+  /// Plays for `wallTicks` ticks' worth of wall-clock time (1 in a scripted frame) at `speed`;
+  /// pauses at the end. Returns false with *error on a fault or a damaged snapshot.
+  bool advance(double wallTicks, std::string* error);
+  /// Steps n ticks (stops at the end).
+  bool step(int64_t n, std::string* error);
+  /// Moves to tick t (0 ≤ t ≤ lastTick(), clamped) through the nearest snapshot.
+  bool seek(int64_t t, std::string* error);
+
+  // ---- the recorded hashes ----
+  int64_t hashesOk() const { return int64_t(okTicks_.size()); }
+  int64_t firstMismatchTick() const { return firstMismatch_; }
+  const std::string& mismatchText() const { return mismatchText_; }
+  /// False under a variant that changes the state (A is always recorded settings).
+  bool hashesComparable() const { return player_->sameSettingsAsRecorded(); }
+
+  // ---- A/B ----
+  bool hasB() const { return b_ != nullptr; }
+  SimWorld& worldB() { return b_->world(); }
+  const Scenario& scenarioB() { return b_->player().scenario(); }
+  const std::string& labelB() const { return labelB_; }
+  /// B's tick in A's time base (B lags by up to mergedTicks()-1 when its step is coarser).
+  int64_t tickB() const { return b_->recordedTick(); }
+  /// The divergence at the last common tick (valid when measured()).
+  bool measured() const { return measured_; }
+  const TickDivergence& divergence() const { return last_; }
+  int64_t firstDivergentTick() const { return firstDivergent_; }
+  const Observation& observationA() const { return obsA_; }
+  const Observation& observationB() const { return obsB_; }
+
+ private:
+  Playback() = default;
+  void checkHash();
+  void buildB();
+  void syncB();
+  std::unique_ptr<sgr::Recording> rec_, recB_;
+  std::unique_ptr<Player> player_;
+  RecordedHashes* hashes_ = nullptr;
+  std::unique_ptr<RecordedHashes> hashesOwned_;
+  int threads_ = 1;
+  double accumulator_ = 0;  ///< recorded ticks not yet run
+  std::set<int64_t> okTicks_;
+  int64_t firstMismatch_ = -1;
+  std::string mismatchText_;
+  // B side.
+  std::unique_ptr<LockStepReplay> b_;
+  VariantSettings variantB_;
+  std::string labelB_;
+  bool measured_ = false;
+  TickDivergence last_;
+  int64_t firstDivergent_ = -1;
+  Observation obsA_, obsB_;
+};
+
+}  // namespace sg::viewer

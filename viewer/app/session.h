@@ -1,0 +1,53 @@
+// The live simulated session: the world, every tick's input since tick 0, the recorder. Panel
+// edits never touch a running world: they edit the scenario's JSON text and build a new Session
+// from it (the text is what a recording embeds, so an edited session still records and verifies).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "replay/recorder.h"
+#include "replay/stage_clock.h"
+#include "sim/world/world.h"
+
+namespace sg::viewer {
+
+class Session {
+ public:
+  Scenario scenario;
+  std::vector<sgr::EmbeddedFile> files;
+  std::string scenarioDir;  ///< folder the scenario's relative file names resolve against
+  std::unique_ptr<SimWorld> world;
+  std::vector<TickInput> history;  ///< history[t]: the input of tick t
+  std::unique_ptr<Recorder> recorder;
+  std::string recordPath;
+  int threads = 1;
+  StageClock clock;
+
+  /// Loads a scenario file (empty: the built-in meadow) and builds its world. Throws ScenarioError.
+  static std::unique_ptr<Session> load(const std::string& path, int threads);
+
+  /// A new session from edited scenario JSON text (same source name and folder), at tick 0; with
+  /// `replayHistory` it then steps through this session's inputs so far (how the level-of-detail
+  /// toggle keeps the session going). Throws ScenarioError; a fault while replaying becomes a
+  /// ScenarioError naming the tick.
+  std::unique_ptr<Session> rebuilt(const std::string& text, bool replayHistory) const;
+
+  StepResult step(const TickInput& input);
+
+  /// Records the whole session, from tick 0, to `path`: a fresh world replays the inputs so far
+  /// under a Recorder (a recording must start from a state a replay can build), must reach the
+  /// live world's hash, and then takes its place.
+  bool startRecording(const std::string& path, std::string* error);
+  /// Writes END and prints "recorded   N ticks to PATH (hash H)".
+  bool stopRecording(std::string* error);
+};
+
+/// The scenario text with one value replaced: `dotted` is a path such as "field.patchesX" or
+/// "bodies.gravity", `value` any JSON value. Throws ScenarioError (file, "$.dotted", expected)
+/// when the text is not an object.
+std::string editScenarioText(const std::string& text, const std::string& sourceName, const std::string& dotted,
+                             const std::string& valueJson);
+
+}  // namespace sg::viewer
