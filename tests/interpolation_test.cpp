@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <set>
 
 #include "tests/test_support.h"
 
@@ -166,6 +168,97 @@ TEST(PatchState, ConstantWeightRowsGiveTheGenericBitsK4Fx32) { checkConstantWeig
 TEST(PatchState, ConstantWeightRowsGiveTheGenericBitsK2Fx16) { checkConstantWeightRowsMatchGeneric<Fx16>(2); }
 TEST(PatchState, ConstantWeightRowsGiveTheGenericBitsK4Double) { checkConstantWeightRowsMatchGeneric<double>(4); }
 TEST(PatchState, ConstantWeightRowsGiveTheGenericBitsK2Float) { checkConstantWeightRowsMatchGeneric<float>(2); }
+
+}  // namespace
+}  // namespace sg
+
+namespace sg {
+namespace {
+
+// The patch stage's unchecked arithmetic must give Fixed's bits for every input, including the
+// ones that overflow (Fixed wraps them too; the patch stage never reports faults).
+template <class S, int K>
+void checkUncheckedLerp() {
+  using Raw = typename S::RawType;
+  std::vector<Raw> values = {0, 1, -1, 2, -2, 3, -3, 5, -5, std::numeric_limits<Raw>::max(), std::numeric_limits<Raw>::min(),
+                             Raw(std::numeric_limits<Raw>::max() - 1), Raw(std::numeric_limits<Raw>::min() + 1),
+                             S::kOneRaw, Raw(-S::kOneRaw), Raw(S::kOneRaw / 2 + 1), Raw(-(S::kOneRaw / 2) - 1)};
+  uint64_t x = 0x9E3779B97F4A7C15ull;  // splitmix64: a fixed, reproducible set of random values
+  for (int i = 0; i < 4000; ++i) {
+    x += 0x9E3779B97F4A7C15ull;
+    uint64_t z = x;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    values.push_back(Raw(z >> (i % 3 == 0 ? 0 : (i % 3 == 1 ? 20 : 40)) % (uint64_t(1) << (sizeof(Raw) * 8 - 1))) *
+                     (i % 2 ? Raw(-1) : Raw(1)));
+  }
+  int64_t checked = 0;
+  for (size_t i = 0; i < values.size(); ++i) {
+    const S a = S::fromRaw(values[i]);
+    const S b = S::fromRaw(values[(i * 7 + 3) % values.size()]);
+    for (int t = 1; t < K; ++t) {
+      const S reference = lerp(a, b, powerOfTwoWeight<S, K>(t));
+      const S fast = unchecked::lerpByFraction<S, K>(a, b, t);
+      ASSERT_EQ(fast.raw(), reference.raw()) << "a " << a.raw() << " b " << b.raw() << " t " << t << "/" << K;
+      ++checked;
+    }
+  }
+  takeFixedFaults();  // the reference raised overflow faults on the extreme values, as it should
+  EXPECT_GT(checked, 4000);
+}
+
+TEST(PatchState, UncheckedLerpIsFixedLerpBitForBit) {
+  checkUncheckedLerp<Fx32, 2>();
+  checkUncheckedLerp<Fx32, 4>();
+  checkUncheckedLerp<Fx16, 2>();
+  checkUncheckedLerp<Fx16, 4>();
+}
+
+template <class S>
+void checkUncheckedWriter() {
+  using Raw = typename S::RawType;
+  PatchArrays<S> a, b;
+  const size_t n = 600;
+  for (PatchArrays<S>* p : {&a, &b}) {
+    for (auto* v : {&p->tipOffsetX, &p->tipOffsetZ, &p->topY, &p->rootY}) v->assign(n, S(0));
+    p->tiltLevel.assign(n, 0);
+    p->cut.assign(n, 0);
+  }
+  PatchStateConstants<S> c;
+  c.halfRod = S::fromRaw(S::kOneRaw / 2);
+  c.scaleY = S(1);
+  c.cutReduction = S::fromRaw(S::kOneRaw / 5);
+  c.minimumTop = S::fromRaw(S::kOneRaw / 10);
+  c.drop[0] = S::fromRaw(S::kOneRaw / 5);
+  c.drop[1] = S::fromRaw(S::kOneRaw * 3 / 10);
+  c.drop[2] = S::fromRaw(S::kOneRaw * 2 / 5);
+  const Raw extremes[] = {std::numeric_limits<Raw>::max(), std::numeric_limits<Raw>::min(), 0, 1, -1};
+  for (size_t q = 0; q < n; ++q) {
+    const Raw root = q % 50 == 0 ? extremes[(q / 50) % 5] : Raw((int64_t(q) - 300) * (S::kOneRaw / 97));
+    a.rootY[q] = b.rootY[q] = S::fromRaw(root);
+    a.cut[q] = b.cut[q] = uint8_t(q % 3 == 0);
+  }
+  const PatchWriter<S> wa(a, c), wb(b, c);
+  for (size_t q = 0; q < n; ++q) {
+    // Sweep the sink through every tilt band and the clamps, with extremes mixed in.
+    const Raw dy = q % 37 == 0 ? extremes[(q / 37) % 5] : Raw((int64_t(q) - 400) * (S::kOneRaw / 300));
+    const S ddx = S::fromRaw(Raw(q)), ddz = S::fromRaw(Raw(-Raw(q)));
+    wa.write(q, ddx, S::fromRaw(dy), ddz);
+    wb.writeFast(q, ddx, S::fromRaw(dy), ddz);
+  }
+  takeFixedFaults();
+  EXPECT_TRUE(a.topY == b.topY);
+  EXPECT_TRUE(a.tiltLevel == b.tiltLevel);
+  EXPECT_TRUE(a.tipOffsetX == b.tipOffsetX && a.tipOffsetZ == b.tipOffsetZ);
+  std::set<uint8_t> levels(a.tiltLevel.begin(), a.tiltLevel.end());
+  EXPECT_EQ(levels.size(), 4u) << "the sweep must reach every tilt level";
+}
+
+TEST(PatchState, UncheckedWriterIsTheCheckedWriterBitForBit) {
+  checkUncheckedWriter<Fx32>();
+  checkUncheckedWriter<Fx16>();
+}
 
 }  // namespace
 }  // namespace sg

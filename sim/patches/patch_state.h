@@ -12,6 +12,7 @@
 
 #include <bit>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "sim/field/grass_field.h"
@@ -29,14 +30,88 @@ struct PatchStateConstants {
   S drop[3]{};
 };
 
-/// Tip displacement of particles [begin, end).
+// ---- unchecked fixed-point arithmetic for the patch stage ------------------------------------
+// The patch stage is derived output: its fault bits are never collected (the next step starts by
+// clearing them), so a result that does not fit simply wraps, as Fixed's own operators return it.
+// These helpers compute exactly Fixed's bits (wrapping add/sub, round-half-away product, modular
+// narrowing) without the fault bookkeeping, which lets the compiler keep the loops branch-light.
+// tests/interpolation_test.cpp checks them against Fixed's operators on edge and random values.
+namespace unchecked {
+
+template <class Raw>
+inline Raw add(Raw a, Raw b) {
+  using U = std::make_unsigned_t<Raw>;
+  return Raw(U(a) + U(b));
+}
+template <class Raw>
+inline Raw sub(Raw a, Raw b) {
+  using U = std::make_unsigned_t<Raw>;
+  return Raw(U(a) - U(b));
+}
+
+/// Fixed's a * b for b = 2^(Frac - m), 1 <= m <= Frac, as a shift: round(d / 2^m), ties away
+/// from zero. Fixed computes (d 2^(Frac-m) + 2^(Frac-1) + sign) >> Frac in the wide type; for
+/// d >= 0 that is (d + 2^(m-1)) >> m; for d < 0 the sign's -1, divided by 2^(Frac-m), lies in
+/// (0, 1], so the floor is that of (d + 2^(m-1) - 1) / 2^m. Neither sum overflows as written.
+template <class Raw, int M>
+inline Raw shiftRound(Raw d) {
+  using U = std::make_unsigned_t<Raw>;
+  if (d >= 0) return Raw((U(d) + (U(1) << (M - 1))) >> M);
+  return Raw(d + ((Raw(1) << (M - 1)) - 1)) >> M;
+}
+
+/// Fixed's lerp(a, b, w) = a + (b - a) * w with the weight t/K (K a power of two).
+template <class S, int K>
+inline S lerpByFraction(S a, S b, int t) {
+  using Raw = typename S::RawType;
+  using Wide = typename S::WideType;
+  constexpr int kRawBits = int(sizeof(Raw) * 8);
+  constexpr int kLogK = std::countr_zero(unsigned(K));
+  const Raw d = sub(b.raw(), a.raw());
+  Raw scaled;
+  if constexpr (K == 2) {
+    scaled = shiftRound<Raw, 1>(d);  // t == 1
+  } else {
+    static_assert(K == 4);
+    if (t == 2) {
+      scaled = shiftRound<Raw, 1>(d);
+    } else if (t == 1) {
+      scaled = shiftRound<Raw, 2>(d);
+    } else {  // t = 3: weight 3 * 2^(Frac - 2), the general product
+      const Wide p = Wide(d) * Wide(Raw(t) << (S::kFracBits - kLogK));
+      scaled = Raw((p + (Wide(1) << (S::kFracBits - 1)) + (p >> (2 * kRawBits - 1))) >> S::kFracBits);
+    }
+  }
+  return S::fromRaw(add(a.raw(), scaled));
+}
+
+}  // namespace unchecked
+
+/// Tip displacement p - anchor - (0, L, 0) of particles [begin, end). Patch-stage data, so the
+/// fixed types compute it unchecked (the same bits): inside the fused particle pass
+/// (particle_row.h) it must not leave a fault bit for the next row's integration to misreport.
 template <class S>
 inline void particleDisplacement(const ParticleArrays<S>& p, int64_t begin, int64_t end, S rod,
                                  std::vector<S>& dx, std::vector<S>& dy, std::vector<S>& dz) {
+  const S* px = p.px.data();
+  const S* py = p.py.data();
+  const S* pz = p.pz.data();
+  const S* ax = p.anchorX.data();
+  const S* ay = p.anchorY.data();
+  const S* az = p.anchorZ.data();
+  S* ox = dx.data();
+  S* oy = dy.data();
+  S* oz = dz.data();
   for (int64_t i = begin; i < end; ++i) {
-    dx[size_t(i)] = p.px[size_t(i)] - p.anchorX[size_t(i)];
-    dy[size_t(i)] = p.py[size_t(i)] - p.anchorY[size_t(i)] - rod;
-    dz[size_t(i)] = p.pz[size_t(i)] - p.anchorZ[size_t(i)];
+    if constexpr (ScalarTraits<S>::isFixed) {
+      ox[i] = S::fromRaw(unchecked::sub(px[i].raw(), ax[i].raw()));
+      oy[i] = S::fromRaw(unchecked::sub(unchecked::sub(py[i].raw(), ay[i].raw()), rod.raw()));
+      oz[i] = S::fromRaw(unchecked::sub(pz[i].raw(), az[i].raw()));
+    } else {
+      ox[i] = px[i] - ax[i];
+      oy[i] = py[i] - ay[i] - rod;
+      oz[i] = pz[i] - az[i];
+    }
   }
 }
 
@@ -58,6 +133,22 @@ struct PatchWriter {
         tiltLevel(patches.tiltLevel.data()), rootY(patches.rootY.data()), cut(patches.cut.data()),
         halfRod(c.halfRod), scaleY(c.scaleY), cutReduction(c.cutReduction), minimumTop(c.minimumTop),
         drop0(c.drop[0]), drop1(c.drop[1]), drop2(c.drop[2]) {}
+
+  /// write() without the fault bookkeeping for the fixed types (the same bits: see `unchecked`).
+  void writeFast(size_t p, S ddx, S ddy, S ddz) const {
+    if constexpr (!ScalarTraits<S>::isFixed) {
+      write(p, ddx, ddy, ddz);
+    } else {
+      using Raw = typename S::RawType;
+      tipOffsetX[p] = ddx;
+      tipOffsetZ[p] = ddz;
+      const Raw sink = unchecked::sub(Raw(0), ddy.raw());
+      const Raw smaller = sink < 0 ? Raw(0) : (sink > halfRod.raw() ? halfRod.raw() : sink);
+      const Raw top = unchecked::sub(unchecked::sub(scaleY.raw(), smaller), cut[p] ? cutReduction.raw() : Raw(0));
+      topY[p] = S::fromRaw(unchecked::add(rootY[p].raw(), top < minimumTop.raw() ? minimumTop.raw() : top));
+      tiltLevel[p] = uint8_t(sink > drop2.raw() ? 3 : sink > drop1.raw() ? 2 : sink > drop0.raw() ? 1 : 0);
+    }
+  }
 
   /// Writes patch p from its tip displacement (ddx, ddy, ddz).
   void write(size_t p, S ddx, S ddy, S ddz) const {
@@ -115,6 +206,12 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
     if constexpr (K != 0) return powerOfTwoWeight<S, K>(t);
     else return weight[t];
   };
+  // K = 0 is the reference: Fixed's checked operators. K = 2, 4 compute the same bits unchecked.
+  constexpr bool kFast = K != 0 && ScalarTraits<S>::isFixed;
+  auto blend = [&weightOf](S a, S b, int t) {
+    if constexpr (kFast) return unchecked::lerpByFraction<S, K>(a, b, t);
+    else return lerp(a, b, weightOf(t));
+  };
   const int64_t b0 = j / k, tz = j % k;
   const int64_t nx = particles.sizeI;
   // Row of displacements at this patch row's z: particle row b0, or a blend of b0 and b0+1, in
@@ -128,14 +225,14 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
     const S* sx = dx.data() + r1;
     const S* sy = dy.data() + r1;
     const S* sz = dz.data() + r1;
-    const S w = weightOf(int(tz));
+    const int t = int(tz);
     S* bx = scratch;
     S* by = scratch + nx;
     S* bz = scratch + 2 * nx;
     for (int64_t a = 0; a < nx; ++a) {
-      bx[a] = lerp(rx[a], sx[a], w);
-      by[a] = lerp(ry[a], sy[a], w);
-      bz[a] = lerp(rz[a], sz[a], w);
+      bx[a] = blend(rx[a], sx[a], t);
+      by[a] = blend(ry[a], sy[a], t);
+      bz[a] = blend(rz[a], sz[a], t);
     }
     rx = bx;
     ry = by;
@@ -156,10 +253,9 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
     for (int t = 0; t < k && i < endI; ++t, ++i) {
       S ddx = rx[sa], ddy = ry[sa], ddz = rz[sa];
       if (t != 0) {
-        const S w = weightOf(t);
-        ddx = lerp(ddx, rx[sb], w);
-        ddy = lerp(ddy, ry[sb], w);
-        ddz = lerp(ddz, rz[sb], w);
+        ddx = blend(ddx, rx[sb], t);
+        ddy = blend(ddy, ry[sb], t);
+        ddz = blend(ddz, rz[sb], t);
       }
       qx[sp] = ddx;
       qy[sp] = ddy;
@@ -170,7 +266,10 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
   }
   const PatchWriter<S> out(patches, c);
   const size_t rowBase = size_t(patchWindow.storageRow(j) * rowSize);
-  for (int64_t q = 0; q < rowSize; ++q) out.write(rowBase + size_t(q), qx[q], qy[q], qz[q]);
+  for (int64_t q = 0; q < rowSize; ++q) {
+    if constexpr (kFast) out.writeFast(rowBase + size_t(q), qx[q], qy[q], qz[q]);
+    else out.write(rowBase + size_t(q), qx[q], qy[q], qz[q]);
+  }
 }
 
 }  // namespace sg
