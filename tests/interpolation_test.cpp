@@ -110,15 +110,16 @@ namespace {
 // The patch stage runs k = 2 and 4 with compile-time weights (sim/patches/patch_state.h): it
 // must give the same bits as the generic row with runtime weights, in every scalar and in a
 // wrapped level-of-detail window (rows and columns stored toroidally).
+// `window` = false: the same check on the whole field (no toroidal wrap), for every k.
 template <class S>
-void checkConstantWeightRowsMatchGeneric(int k) {
+void checkConstantWeightRowsMatchGeneric(int k, bool window = true) {
   Scenario s = test::thesisMeadow();
-  s.field.patchesX = 161;
-  s.field.patchesZ = 145;
+  s.field.patchesX = window ? 161 : 401;
+  s.field.patchesZ = window ? 145 : 401;
   s.particles.interpolation = k;
   s.wind.travelSpeed = Rational{1, 2};
   s.scalar = ScalarTraits<S>::kind;
-  s.lod.mode = LodMode::Window;
+  s.lod.mode = window ? LodMode::Window : LodMode::Off;
   s.lod.windowX = 15;  // particles
   s.lod.windowZ = 13;
   World<S> w(s, 1);
@@ -128,7 +129,9 @@ void checkConstantWeightRowsMatchGeneric(int k) {
     in.camera = InputVec3{int64_t(t % 30) << 30, 0, int64_t(t % 25) << 29};  // drags the window around
     ASSERT_TRUE(w.step(in).ok);
   }
-  ASSERT_TRUE(w.patchWindow().originI != 0 || w.patchWindow().originJ != 0) << "the window must have moved";
+  if (window) {
+    ASSERT_TRUE(w.patchWindow().originI != 0 || w.patchWindow().originJ != 0) << "the window must have moved";
+  }
   // Inputs of the row function, as the world's patch stage sees them.
   const auto& p = w.particles();
   const ParticleGrid& g = w.particleGrid();
@@ -142,15 +145,23 @@ void checkConstantWeightRowsMatchGeneric(int k) {
   c.halfRod = rod / S(2);
   c.scaleY = S(1);
   c.minimumTop = S(0);
-  ASSERT_TRUE(rowWeightsAreExact(c));
+  const bool constantWeights = k == 2 || k == 4;
+  ASSERT_EQ(rowWeightsAreExact(c), constantWeights);
   const LatticeWindow& pw = w.patchWindow();
   PatchArrays<S> generic = w.patches(), constant = w.patches();
   std::vector<S> scratch(size_t(3 * (g.countX + pw.sizeI)));
   int64_t compared = 0;
-  for (int64_t j = pw.originJ; j < pw.originJ + pw.sizeJ; ++j) {
+  if (k == 1) {  // patches are particles: the checked writer straight over them
+    const PatchWriter<S> out(generic, c);
+    for (int64_t q = 0; q < g.size(); ++q) out.write(size_t(q), dx[size_t(q)], dy[size_t(q)], dz[size_t(q)]);
+    constant = generic;
+    compared = g.size();
+  }
+  for (int64_t j = pw.originJ; k > 1 && j < pw.originJ + pw.sizeJ; ++j) {
     updatePatchRow<S>(generic, pw, j, g.window, dx, dy, dz, c, scratch.data());
     if (k == 2) updatePatchRow<S, 2>(constant, pw, j, g.window, dx, dy, dz, c, scratch.data());
-    else updatePatchRow<S, 4>(constant, pw, j, g.window, dx, dy, dz, c, scratch.data());
+    else if (k == 4) updatePatchRow<S, 4>(constant, pw, j, g.window, dx, dy, dz, c, scratch.data());
+    else updatePatchRow<S>(constant, pw, j, g.window, dx, dy, dz, c, scratch.data());
     compared += pw.sizeI;
   }
   EXPECT_EQ(compared, pw.sizeI * pw.sizeJ);
@@ -168,6 +179,11 @@ TEST(PatchState, ConstantWeightRowsGiveTheGenericBitsK4Fx32) { checkConstantWeig
 TEST(PatchState, ConstantWeightRowsGiveTheGenericBitsK2Fx16) { checkConstantWeightRowsMatchGeneric<Fx16>(2); }
 TEST(PatchState, ConstantWeightRowsGiveTheGenericBitsK4Double) { checkConstantWeightRowsMatchGeneric<double>(4); }
 TEST(PatchState, ConstantWeightRowsGiveTheGenericBitsK2Float) { checkConstantWeightRowsMatchGeneric<float>(2); }
+TEST(PatchState, WholeFieldPatchRowsGiveTheGenericBitsForEveryK) {
+  for (int k : {1, 2, 3, 4}) checkConstantWeightRowsMatchGeneric<Fx32>(k, false);
+  checkConstantWeightRowsMatchGeneric<Fx16>(2, false);
+  checkConstantWeightRowsMatchGeneric<double>(3, false);
+}
 
 }  // namespace
 }  // namespace sg

@@ -90,6 +90,8 @@ nlohmann::json tickJson(const TickDivergence& d) {
           {"bodyAngleMax", d.bodyAngleMax},
           {"contactsA", d.contactsA},
           {"contactsB", d.contactsB},
+          {"bodiesA", d.bodiesA},  // differ once one run spawned a body the other did not
+          {"bodiesB", d.bodiesB},
           {"identical", d.identical}};
 }
 

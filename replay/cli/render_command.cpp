@@ -268,7 +268,7 @@ int render(const RenderOptions& o) {
   std::string badItem;
   if (!parseDebugList(o.debug, &debug, &badItem))
     return fail(kExitBadInput, "--debug: expected a comma list of particles, constraints, primitives, cells, contacts, got '" +
-                                   o.debug + "'" + (badItem.empty() ? "" : " ('" + badItem + "')"));
+                                   o.debug + "'" + (badItem.empty() || badItem == o.debug ? "" : " ('" + badItem + "' is none of them)"));
 
   // ---- the world ----
   Scenario scenario;
