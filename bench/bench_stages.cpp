@@ -12,11 +12,15 @@
 //   BM_StateHash, BM_SaveState, BM_RestoreState /<scalar>/side:S   stateHash(), saveState(),
 //                     restoreState(); counters bytes/patch and state bytes/s
 //   BM_CopyBandwidth/threads:T   memcpy over 2 x 256 MiB (>> the 32 MiB L3): bytes/s counts read + write
-//   BM_IntegrateConstraints/<scalar>/threads:T   the integrate and constraints stages at 1,000,000
-//                     particles (side 1000, k = 1); bytes_per_tick = particle state those stages read
-//                     and write (15 scalars per particle), bound_ms = bytes_per_tick / copy
-//                     bandwidth measured in the same run, ratio_to_bound = achieved / bound
-//                     (the issue asks for <= 2 for fx32); fx16 vs fx32: particle_steps/s
+//   BM_IntegrateConstraints/<scalar>/threads:T/avx2:V   the integrate and constraints stages at
+//                     1,000,000 particles (side 1000, k = 1) with the scalar reference (V = 0) or
+//                     the AVX2 kernel (V = 1; the label says which ran); bytes_per_tick = particle
+//                     state those stages read and write (15 scalars per particle), bound_ms =
+//                     bytes_per_tick / copy bandwidth measured in the same run, ratio_to_bound =
+//                     achieved / bound (the issue asks for <= 2 for fx32); fx16 vs fx32:
+//                     particle_steps/s
+// Every other benchmark runs the world's default kernel (AVX2 where the CPU has it; the
+// environment variable SIMGRASS_KERNEL=scalar selects the reference) and names it in its label.
 // The window shift is in bench_lod.cpp (BM_WindowTick, BM_EdgeRingShift).
 // Filters (docs/performance.md, "Benchmark suites"):
 //   simgrass_bench --benchmark_filter='BM_Stages/fx32/side:151/'       thesis size, all variants
@@ -82,6 +86,7 @@ void BM_Stages(benchmark::State& state, ScalarKind scalar) {
     if (!world->step(sg::TickInput{}, &timer).ok) state.SkipWithError("simulation fault");
   stageCounters(state, timer);
   patchCounters(state, *world);
+  state.SetLabel(sg::particleKernelName(world->particleKernel()));
 }
 
 void stageArgs(benchmark::internal::Benchmark* b) {
@@ -112,6 +117,7 @@ void BM_TargetTick(benchmark::State& state) {
   const double ticksPerSecond = double(state.iterations()) / seconds;
   state.counters["ticks/s"] = ticksPerSecond;
   state.counters["vs_target"] = ticksPerSecond / kTargetTicksPerSecond;  // >= 1: the target is met
+  state.SetLabel(sg::particleKernelName(world->particleKernel()));
 }
 BENCHMARK(BM_TargetTick)->Unit(benchmark::kMillisecond)->UseRealTime();
 
@@ -258,6 +264,8 @@ void BM_IntegrateConstraints(benchmark::State& state) {
   const int threads = int(state.range(0));
   const sg::Scenario s = meadow(1000, 1, sg::ScalarTraits<S>::kind, false);
   auto world = sg::makeWorld(s, threads);
+  world->setParticleKernel(state.range(1) ? sg::ParticleKernel::Avx2 : sg::ParticleKernel::Scalar);
+  state.SetLabel(sg::particleKernelName(world->particleKernel()));
   for (int t = 0; t < 10; ++t) world->step(sg::TickInput{});
   const double bandwidth = copyBandwidth(threads, 3);  // same run, same thread count
   StageTimer timer;
@@ -277,13 +285,16 @@ void BM_IntegrateConstraints(benchmark::State& state) {
   // Particle steps per second of these two stages alone (fx16 vs fx32: the issue asks for 1.5x).
   state.counters["particle_steps/s"] = particles / (achievedMs / 1e3);
 }
-BENCHMARK_TEMPLATE(BM_IntegrateConstraints, sg::Fx32)->Arg(1)->Arg(2)->ArgName("threads")
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->Name("BM_IntegrateConstraints/fx32");
-BENCHMARK_TEMPLATE(BM_IntegrateConstraints, sg::Fx16)->Arg(1)->Arg(2)->ArgName("threads")
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->Name("BM_IntegrateConstraints/fx16");
-BENCHMARK_TEMPLATE(BM_IntegrateConstraints, float)->Arg(1)->Arg(2)->ArgName("threads")
+void kernelArgs(benchmark::internal::Benchmark* b) {
+  for (int threads : {1, 2})
+    for (int avx2 : {0, 1}) b->Args({threads, avx2});
+  b->ArgNames({"threads", "avx2"})->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+BENCHMARK_TEMPLATE(BM_IntegrateConstraints, sg::Fx32)->Apply(kernelArgs)->Name("BM_IntegrateConstraints/fx32");
+BENCHMARK_TEMPLATE(BM_IntegrateConstraints, sg::Fx16)->Apply(kernelArgs)->Name("BM_IntegrateConstraints/fx16");
+BENCHMARK_TEMPLATE(BM_IntegrateConstraints, float)->Args({1, 0})->Args({2, 0})->ArgNames({"threads", "avx2"})
     ->Unit(benchmark::kMillisecond)->UseRealTime()->Name("BM_IntegrateConstraints/float");
-BENCHMARK_TEMPLATE(BM_IntegrateConstraints, double)->Arg(1)->Arg(2)->ArgName("threads")
+BENCHMARK_TEMPLATE(BM_IntegrateConstraints, double)->Args({1, 0})->Args({2, 0})->ArgNames({"threads", "avx2"})
     ->Unit(benchmark::kMillisecond)->UseRealTime()->Name("BM_IntegrateConstraints/double");
 
 }  // namespace

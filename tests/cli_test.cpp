@@ -37,7 +37,7 @@ TEST(CliHelp, TopLevelHelpListsRun) {
 TEST(CliHelp, RunHelpListsEveryOption) {
   const CliResult r = runCli("run --help");
   EXPECT_EQ(r.exitCode, 0) << r.describe();
-  for (const char* opt : {"--ticks", "--scalar", "--interp", "--threads", "--hash-every", "--json"})
+  for (const char* opt : {"--ticks", "--scalar", "--interp", "--threads", "--hash-every", "--kernel", "--json"})
     EXPECT_NE(r.out.find(opt), std::string::npos) << opt << "\n" << r.describe();
 }
 
@@ -81,6 +81,32 @@ TEST(CliRun, HashIsIndependentOfThreadCount) {
   EXPECT_TRUE(isHex16(a.value("finalHash", "")));
   EXPECT_EQ(a.value("finalHash", "a"), b.value("finalHash", "b"));
   EXPECT_EQ(a.value("finalHash", "a"), c.value("finalHash", "c"));
+}
+
+TEST(CliRun, HashIsIndependentOfTheParticleKernel) {
+  for (const char* scalar : {"fx32", "fx16"}) {
+    const std::string base = std::string("run --ticks 20 --json --interp 2 --scalar ") + scalar;
+    const CliResult ref = runCli(base + " --kernel scalar");
+    const CliResult vec = runCli(base + " --kernel avx2");
+    const CliResult aut = runCli(base);
+    ASSERT_EQ(ref.exitCode, 0) << ref.describe();
+    ASSERT_EQ(vec.exitCode, 0) << vec.describe();
+    ASSERT_EQ(aut.exitCode, 0) << aut.describe();
+    const json a = parseJson(ref), b = parseJson(vec), c = parseJson(aut);
+    EXPECT_EQ(a.value("kernel", ""), "scalar");
+    // avx2 where the CPU has it; the reference otherwise (and the output says which ran)
+    EXPECT_EQ(b.value("kernel", ""), sg::avx2KernelAvailable() ? "avx2" : "scalar");
+    EXPECT_EQ(c.value("kernel", ""), b.value("kernel", "")) << "auto picks the vector kernel where available";
+    EXPECT_TRUE(isHex16(a.value("finalHash", "")));
+    EXPECT_EQ(a.value("finalHash", "a"), b.value("finalHash", "b")) << scalar;
+    EXPECT_EQ(a.value("finalHash", "a"), c.value("finalHash", "c")) << scalar;
+  }
+  const CliResult dbl = runCli("run --ticks 2 --json --scalar double --kernel avx2");
+  ASSERT_EQ(dbl.exitCode, 0) << dbl.describe();
+  EXPECT_EQ(parseJson(dbl).value("kernel", ""), "scalar") << "float and double always run the reference";
+  const CliResult bad = runCli("run --ticks 2 --kernel sse9");
+  EXPECT_EQ(bad.exitCode, 2) << bad.describe();
+  EXPECT_NE(bad.err.find("--kernel"), std::string::npos) << bad.describe();
 }
 
 TEST(CliRun, HashEveryListsIntermediateHashes) {

@@ -21,6 +21,19 @@ nlohmann::json goldens() {
   return nlohmann::json::parse(in);
 }
 
+/// Every committed golden: scenario and scalar (tests/golden/state_hashes.json).
+const std::vector<GoldenCase> kGoldenCases = {
+    {"thesis-meadow", "fx32"}, {"thesis-meadow", "fx16"}, {"hilly-meadow", "fx32"}, {"hilly-meadow", "fx16"},
+    {"thesis-bodies", "fx32"}, {"thesis-bodies", "fx16"}, {"mower-field", "fx32"},  {"mower-field", "fx16"},
+    {"lod-crossing", "fx32"},  {"lod-crossing", "fx16"}};
+
+/// A test name from a golden case ("thesis_meadow_fx32").
+std::string caseName(const GoldenCase& c) {
+  std::string n = c.scenario + "_" + c.scalar;
+  for (char& ch : n) if (ch == '-') ch = '_';
+  return n;
+}
+
 std::string hex(uint64_t h) {
   char buf[19];
   std::snprintf(buf, sizeof buf, "%016llx", (unsigned long long)h);
@@ -59,18 +72,26 @@ TEST_P(GoldenHash, MatchesCommittedHashAfter600Ticks) {
 
 INSTANTIATE_TEST_SUITE_P(
     ScenariosScalarsThreads, GoldenHash,
-    ::testing::Combine(::testing::Values(GoldenCase{"thesis-meadow", "fx32"}, GoldenCase{"thesis-meadow", "fx16"},
-                                         GoldenCase{"hilly-meadow", "fx32"}, GoldenCase{"hilly-meadow", "fx16"},
-                                         GoldenCase{"thesis-bodies", "fx32"}, GoldenCase{"thesis-bodies", "fx16"},
-                                         GoldenCase{"mower-field", "fx32"}, GoldenCase{"mower-field", "fx16"},
-                                         GoldenCase{"lod-crossing", "fx32"}, GoldenCase{"lod-crossing", "fx16"}),
-                       ::testing::Values(1, 2, 4)),
+    ::testing::Combine(::testing::ValuesIn(kGoldenCases), ::testing::Values(1, 2, 4)),
     [](const auto& info) {
-      const GoldenCase& c = std::get<0>(info.param);
-      std::string n = c.scenario + "_" + c.scalar + "_threads" + std::to_string(std::get<1>(info.param));
-      for (char& ch : n) if (ch == '-') ch = '_';
-      return n;
+      return caseName(std::get<0>(info.param)) + "_threads" + std::to_string(std::get<1>(info.param));
     });
+
+// The scalar reference kernel must reach the same goldens (the default is the AVX2 kernel on
+// CPUs that have it; tests/particle_kernel_test.cpp compares the two tick by tick).
+class GoldenHashScalarKernel : public ::testing::TestWithParam<GoldenCase> {};
+
+TEST_P(GoldenHashScalarKernel, MatchesCommittedHashAfter600Ticks) {
+  const GoldenCase c = GetParam();
+  const nlohmann::json g = goldens();
+  auto w = build(c, 2);
+  w->setParticleKernel(ParticleKernel::Scalar);
+  runTicks(*w, g.at("ticks").get<int64_t>(), scenarioOf(c));
+  EXPECT_EQ(hex(w->stateHash()), g.at(c.scenario + "/" + c.scalar).get<std::string>()) << c.scenario << " " << c.scalar;
+}
+
+INSTANTIATE_TEST_SUITE_P(Goldens, GoldenHashScalarKernel,
+                         ::testing::ValuesIn(kGoldenCases), [](const auto& info) { return caseName(info.param); });
 
 class SaveRestore : public ::testing::TestWithParam<GoldenCase> {};
 
@@ -91,16 +112,7 @@ TEST_P(SaveRestore, RestoreAtTick300ContinuesToTheGoldenHash) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Goldens, SaveRestore,
-                         ::testing::Values(GoldenCase{"thesis-meadow", "fx32"}, GoldenCase{"thesis-meadow", "fx16"},
-                                           GoldenCase{"hilly-meadow", "fx32"}, GoldenCase{"hilly-meadow", "fx16"},
-                                           GoldenCase{"thesis-bodies", "fx32"}, GoldenCase{"thesis-bodies", "fx16"},
-                                         GoldenCase{"mower-field", "fx32"}, GoldenCase{"mower-field", "fx16"},
-                                         GoldenCase{"lod-crossing", "fx32"}, GoldenCase{"lod-crossing", "fx16"}),
-                         [](const auto& info) {
-                           std::string n = info.param.scenario + "_" + info.param.scalar;
-                           for (char& ch : n) if (ch == '-') ch = '_';
-                           return n;
-                         });
+                         ::testing::ValuesIn(kGoldenCases), [](const auto& info) { return caseName(info.param); });
 
 // float and double promise only same-binary reproducibility, but for any thread count.
 TEST(FloatDeterminism, SameHashForOneTwoAndFourThreads) {

@@ -113,6 +113,28 @@ class Script(unittest.TestCase):
         self.assertEqual(p.returncode, 1)
         self.assertIn("note: compiler differs", p.stdout)
 
+    def test_other_particle_kernel_skips_all_but_the_scalar_workloads(self):
+        # Baseline taken where the AVX2 kernel ran; this CPU runs the reference: the default-kernel
+        # counts are of other code and are not compared, the "-scalar" ones still are.
+        with open(self.baseline, "w") as f:
+            json.dump({"thresholdPercent": 2.0, "tools": dict(self.tools, particleKernel="avx2"),
+                       "workloads": {"alpha": {"instructions": 1_000_000},
+                                     "beta-scalar": {"instructions": 2_000_000}}}, f)
+        with open(self.counts, "w") as f:
+            json.dump({"alpha": 3_000_000, "beta-scalar": 2_000_000,
+                       "_tools": dict(self.tools, particleKernel="scalar")}, f)
+        p = run_gate("--counts", self.counts, "--baseline", self.baseline, "--json")
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        data = json.loads(p.stdout)
+        self.assertEqual({w["name"]: w["verdict"] for w in data["workloads"]}, {"alpha": "skipped", "beta-scalar": "ok"})
+        self.assertTrue(any("default particle kernel differs" in n for n in data["notes"]), data["notes"])
+        with open(self.counts, "w") as f:  # the scalar workloads still fail on a rise
+            json.dump({"alpha": 3_000_000, "beta-scalar": 2_100_000,
+                       "_tools": dict(self.tools, particleKernel="scalar")}, f)
+        p = run_gate("--counts", self.counts, "--baseline", self.baseline)
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        self.assertIn("beta-scalar: +5.00 %", p.stderr)
+
     def test_malformed_baseline_exits_2_with_one_line(self):
         with open(self.baseline, "w") as f:
             f.write('{"workloads": {"alpha": {"instructions": "many"}}}')

@@ -9,6 +9,11 @@
 //
 //   simgrass_perf_workloads --list [--json]     the workloads, one a line
 //   simgrass_perf_workloads NAME [--json]       run one (natively: the gate adds callgrind)
+//
+// The fixed-point workloads run the world's default particle kernel (AVX2 where the CPU has it,
+// as callgrind's virtual CPU does); the "-scalar" ones force the scalar reference, so that both
+// implementations are gated. --build-info names the default, and the gate compares only counts
+// taken with the same one (docs/performance.md, "Regression gate").
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -79,6 +84,13 @@ std::function<Outcome()> run(const sg::Scenario& s, int64_t ticks) {
   return stepping(std::shared_ptr<sg::SimWorld>(sg::makeWorld(s, 1)), s, ticks);
 }
 
+/// As run(), with the scalar reference particle kernel whatever the CPU has.
+std::function<Outcome()> runScalarKernel(const sg::Scenario& s, int64_t ticks) {
+  std::shared_ptr<sg::SimWorld> world(sg::makeWorld(s, 1));
+  world->setParticleKernel(sg::ParticleKernel::Scalar);
+  return stepping(world, s, ticks);
+}
+
 // Tick counts: each workload is 0.1-0.5 s natively, 10-30 s under callgrind on the 2-core VM.
 const std::vector<Workload>& workloads() {
   using sg::ScalarKind;
@@ -89,6 +101,10 @@ const std::vector<Workload>& workloads() {
        [](const std::string&) { return run(builtInMeadow(ScalarKind::Fx32, 2), 40); }},
       {"meadow-fx16-k1", "thesis meadow, fx16, k=1: 30 ticks",
        [](const std::string&) { return run(builtInMeadow(ScalarKind::Fx16, 1), 30); }},
+      {"meadow-fx32-k1-scalar", "thesis meadow, fx32, k=1, the scalar reference particle kernel: 20 ticks",
+       [](const std::string&) { return runScalarKernel(builtInMeadow(ScalarKind::Fx32, 1), 20); }},
+      {"meadow-fx16-k1-scalar", "thesis meadow, fx16, k=1, the scalar reference particle kernel: 30 ticks",
+       [](const std::string&) { return runScalarKernel(builtInMeadow(ScalarKind::Fx16, 1), 30); }},
       {"bodies-fx32", "scenarios/thesis-bodies.json (3 bodies: collision, response, grid broad phase): 30 ticks",
        [](const std::string& dir) { return run(sg::loadScenarioFile(dir + "/thesis-bodies.json"), 30); }},
       {"mower-fx32", "scenarios/mower-field.json (compound mower body, cutting): 40 ticks, past its push at tick 30",
@@ -169,10 +185,13 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   if (info) {
+    const char* kernel = sg::particleKernelName(sg::defaultParticleKernel());
     if (json)
-      std::printf("%s\n", nlohmann::json{{"buildId", sg::buildId()}, {"compiler", __VERSION__}}.dump().c_str());
+      std::printf("%s\n", nlohmann::json{{"buildId", sg::buildId()}, {"compiler", __VERSION__}, {"particleKernel", kernel}}
+                              .dump()
+                              .c_str());
     else
-      std::printf("%s (compiler %s)\n", sg::buildId().c_str(), __VERSION__);
+      std::printf("%s (compiler %s, %s particle kernel)\n", sg::buildId().c_str(), __VERSION__, kernel);
     return 0;
   }
   if (list) {

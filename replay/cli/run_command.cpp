@@ -24,6 +24,7 @@ struct RunOptions {
   std::string broadphase;      // particles vs bodies: grid | brute
   std::string bodyBroadphase;  // bodies vs bodies: brute | sap
   std::string lod;             // off | window
+  std::string kernel;          // particle pass: auto | scalar | avx2
   bool json = false;
 };
 
@@ -46,6 +47,8 @@ int runScenario(const RunOptions& o) {
       scenario.bodies.bodyBroadphase = o.bodyBroadphase == "sap" ? BodyBroadphase::SweepAndPrune : BodyBroadphase::Brute;
     if (!o.lod.empty()) scenario.lod.mode = o.lod == "window" ? LodMode::Window : LodMode::Off;
     world = makeWorld(scenario, o.threads, physicalMemoryBytes());
+    if (o.kernel == "scalar" || o.kernel == "avx2")
+      world->setParticleKernel(o.kernel == "avx2" ? ParticleKernel::Avx2 : ParticleKernel::Scalar);
   } catch (const ScenarioError& e) {
     std::fprintf(stderr, "simgrass run: %s\n", e.what());
     return 2;
@@ -91,6 +94,7 @@ int runScenario(const RunOptions& o) {
     j["scalar"] = scalarName(scenario.scalar);
     j["interpolation"] = counts.interpolation;
     j["threads"] = counts.threads;
+    j["kernel"] = particleKernelName(world->particleKernel());
     j["counts"] = {{"patchesX", counts.patchesX}, {"patchesZ", counts.patchesZ}, {"patches", counts.patches()},
                    {"particlesX", counts.particlesX}, {"particlesZ", counts.particlesZ},
                    {"particles", counts.particles()}, {"bodies", counts.bodies}, {"contacts", counts.contacts}};
@@ -109,8 +113,9 @@ int runScenario(const RunOptions& o) {
     std::printf("%s\n", j.dump(2).c_str());
   } else {
     std::printf("scenario   %s (%s)\n", scenario.name.c_str(), scenario.sourceName.c_str());
-    std::printf("scalar     %s, interpolation k=%d, %d thread%s\n", scalarName(scenario.scalar), counts.interpolation,
-                counts.threads, counts.threads == 1 ? "" : "s");
+    std::printf("scalar     %s, interpolation k=%d, %d thread%s, %s particle kernel\n", scalarName(scenario.scalar),
+                counts.interpolation, counts.threads, counts.threads == 1 ? "" : "s",
+                particleKernelName(world->particleKernel()));
     std::printf("patches    %" PRId64 " (%" PRId64 " x %" PRId64 "), particles %" PRId64 " (%" PRId64 " x %" PRId64 ")\n",
                 counts.patches(), counts.patchesX, counts.patchesZ, counts.particles(), counts.particlesX,
                 counts.particlesZ);
@@ -158,6 +163,10 @@ void addRunCommand(CLI::App& app, int* exitCode) {
       ->check(CLI::IsMember({"brute", "sap"}));
   run->add_option("--lod", opts->lod, "Level of detail: off (the whole field) or window (around the camera)")
       ->check(CLI::IsMember({"off", "window"}));
+  run->add_option("--kernel", opts->kernel,
+                  "Particle pass: auto (AVX2 where the CPU has it, for fx32/fx16), scalar (the reference) or avx2 "
+                  "(the state is identical)")
+      ->check(CLI::IsMember({"auto", "scalar", "avx2"}));
   run->add_flag("--json", opts->json, "Machine-readable output");
   run->callback([opts, exitCode] { *exitCode = runScenario(*opts); });
 }

@@ -6,6 +6,10 @@
 // to three whole-array passes, but a row's nine arrays (501 particles * 9 * 8 B = 36 KB at
 // 1,000,000 patches, k = 2) stay in L1/L2 between them instead of streaming the whole particle
 // state (18 MB there) through memory three times (docs/performance.md, "Fused particle pass").
+//
+// Two implementations give the same bits: the scalar reference below, and for the fixed-point
+// scalars an AVX2 kernel (particle_row_avx2.cpp) that runs four particles per instruction and
+// hands any block it cannot prove exact to the reference (docs/performance.md, "Vector kernel").
 #pragma once
 
 #include <cstdint>
@@ -24,18 +28,48 @@ struct RowFault {
   Stage stage = Stage::Integrate;
 };
 
-/// Integrates, projects and measures particles [begin, end) of one row; (dvx, dvy, dvz) is the
-/// row's (a + F/m) dt. Writes the tip displacement p - anchor - (0, L, 0) into (dx, dy, dz).
-/// A fault stops the row at the faulting particle, in the stage that raised it.
+/// Which implementation of the fused particle pass a world runs. Both give bit-identical state
+/// and the same fault reports; Avx2 applies to the fixed-point scalars on CPUs that have it.
+enum class ParticleKernel : uint8_t { Scalar = 0, Avx2 = 1 };
+
+/// "scalar" or "avx2".
+const char* particleKernelName(ParticleKernel kernel);
+/// Whether this CPU runs the AVX2 kernel.
+bool avx2KernelAvailable();
+/// The kernel a new world uses: AVX2 where available, unless the environment variable
+/// SIMGRASS_KERNEL=scalar asks for the reference (read once per process).
+ParticleKernel defaultParticleKernel();
+
+/// The reference: integrates, projects and measures particles [begin, end) of one row;
+/// (dvx, dvy, dvz) is the row's (a + F/m) dt. Writes the tip displacement p - anchor - (0, L, 0)
+/// into (dx, dy, dz). A fault stops the row at the faulting particle, in the stage that raised
+/// it; an integration fault anywhere in the row is reported before any projection fault.
 template <class S, bool Pbd>
-inline RowFault advanceParticleRow(ParticleArrays<S>& p, int64_t begin, int64_t end, S dvx, S dvy, S dvz,
-                                   const ParticleConstants<S>& c, std::vector<S>& dx, std::vector<S>& dy,
-                                   std::vector<S>& dz) {
+inline RowFault advanceParticleRowScalar(ParticleArrays<S>& p, int64_t begin, int64_t end, S dvx, S dvy, S dvz,
+                                         const ParticleConstants<S>& c, std::vector<S>& dx, std::vector<S>& dy,
+                                         std::vector<S>& dz) {
   if (const int64_t at = integrateParticleRow<S, Pbd>(p, begin, end, dvx, dvy, dvz, c); at >= 0)
     return {at, Stage::Integrate};
   if (const int64_t at = projectRodRow<S, Pbd>(p, begin, end, c); at >= 0) return {at, Stage::Constraints};
   particleDisplacement(p, begin, end, c.rodLength, dx, dy, dz);
   return {};
+}
+
+/// The AVX2 kernel (Fx32 and Fx16 only; particle_row_avx2.cpp). Same contract and bits as
+/// advanceParticleRowScalar. Call only when avx2KernelAvailable().
+template <class S, bool Pbd>
+RowFault advanceParticleRowAvx2(ParticleArrays<S>& p, int64_t begin, int64_t end, S dvx, S dvy, S dvz,
+                                const ParticleConstants<S>& c, std::vector<S>& dx, std::vector<S>& dy,
+                                std::vector<S>& dz);
+
+/// The fused pass with the chosen kernel (float and double always run the reference).
+template <class S, bool Pbd>
+inline RowFault advanceParticleRow(ParticleKernel kernel, ParticleArrays<S>& p, int64_t begin, int64_t end, S dvx,
+                                   S dvy, S dvz, const ParticleConstants<S>& c, std::vector<S>& dx,
+                                   std::vector<S>& dy, std::vector<S>& dz) {
+  if constexpr (ScalarTraits<S>::isFixed)
+    if (kernel == ParticleKernel::Avx2) return advanceParticleRowAvx2<S, Pbd>(p, begin, end, dvx, dvy, dvz, c, dx, dy, dz);
+  return advanceParticleRowScalar<S, Pbd>(p, begin, end, dvx, dvy, dvz, c, dx, dy, dz);
 }
 
 }  // namespace sg

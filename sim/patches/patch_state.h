@@ -10,6 +10,7 @@
 //     tilt      = 3 if d.y < -drop[2], 2 if < -drop[1], 1 if < -drop[0], else 0
 #pragma once
 
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <type_traits>
@@ -164,6 +165,20 @@ struct PatchWriter {
   }
 };
 
+/// AVX2 versions of the two contiguous loops below, for Fx32 and Fx16 (patch_row_avx2.cpp), with
+/// the same bits; call them only where the CPU has AVX2 (avx2KernelAvailable()).
+/// out[i] = a[i] + round((b[i] - a[i]) / 2^m), ties away from zero, m = 1 or 2: lerpByFraction
+/// for the weights 1/2 and 1/4 (and 2/4).
+template <class S>
+void blendRowsAvx2(const S* a, const S* b, S* out, int64_t n, int m);
+/// out[2u] = r[u], out[2u + 1] = lerpByFraction<S, 2>(r[u], r[u + 1], 1) for u in [0, pairs)
+/// (reads r[pairs]).
+template <class S>
+void interpolateHalvesAvx2(const S* r, S* out, int64_t pairs);
+/// w.writeFast(first + q, dx[q], dy[q], dz[q]) for q in [0, count).
+template <class S>
+void writePatchesAvx2(const PatchWriter<S>& w, size_t first, const S* dx, const S* dy, const S* dz, int64_t count);
+
 /// t / K as a constant, for K a power of two: exact in every scalar (the runtime weight
 /// c.weight[t] holds the same value; rowWeightsAreExact checks), so the compiler turns the
 /// multiplications by it into shifts and unrolls the patches between two particles.
@@ -195,11 +210,13 @@ inline bool rowWeightsAreExact(const PatchStateConstants<S>& c) {
 /// covers patch columns [k originI, k (originI + sizeI - 1)] at most, so every patch lies between
 /// two held particles. `scratch` holds 3 * (particles.sizeI + patchWindow.sizeI) values. K = 0 takes k and the weights
 /// from `c`; K = c.k (2 or 4, when rowWeightsAreExact) uses constant weights: the same bits,
-/// about a third fewer instructions.
+/// about a third fewer instructions. `vector` (K = 2, 4 and the fixed types only) runs the row blend
+/// and the patch writes with the AVX2 loops: the same bits again.
 template <class S, int K = 0>
 inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWindow, int64_t j,
                            const LatticeWindow& particles, const std::vector<S>& dx, const std::vector<S>& dy,
-                           const std::vector<S>& dz, const PatchStateConstants<S>& c, S* scratch) {
+                           const std::vector<S>& dz, const PatchStateConstants<S>& c, S* scratch,
+                           bool vector = false) {
   const int k = K != 0 ? K : c.k;
   const S* weight = c.weight.data();
   auto weightOf = [weight](int t) {
@@ -229,10 +246,20 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
     S* bx = scratch;
     S* by = scratch + nx;
     S* bz = scratch + 2 * nx;
-    for (int64_t a = 0; a < nx; ++a) {
-      bx[a] = blend(rx[a], sx[a], t);
-      by[a] = blend(ry[a], sy[a], t);
-      bz[a] = blend(rz[a], sz[a], t);
+    // The shift weights 1/2 (K = 2, 4) and 1/4 (K = 4) vectorised; 3/4 is a product.
+    const int shift = K == 2 || (K == 4 && t == 2) ? 1 : K == 4 && t == 1 ? 2 : 0;
+    if (kFast && vector && shift != 0) {
+      if constexpr (kFast) {
+        blendRowsAvx2(rx, sx, bx, nx, shift);
+        blendRowsAvx2(ry, sy, by, nx, shift);
+        blendRowsAvx2(rz, sz, bz, nx, shift);
+      }
+    } else {
+      for (int64_t a = 0; a < nx; ++a) {
+        bx[a] = blend(rx[a], sx[a], t);
+        by[a] = blend(ry[a], sy[a], t);
+        bz[a] = blend(rz[a], sz[a], t);
+      }
     }
     rx = bx;
     ry = by;
@@ -249,6 +276,21 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
   int64_t sa = particles.storageColumn(patchWindow.originI / k);
   int64_t sp = patchWindow.storageColumn(patchWindow.originI);
   for (int64_t i = patchWindow.originI; i < endI;) {
+    if constexpr (kFast && K == 2) {
+      // The run up to the next wrap of either storage row, vectorised (all of it with the level
+      // of detail off); the scalar steps below cross the wrap.
+      const int64_t pairs = std::min({nx - 1 - sa, (rowSize - sp) / 2, (endI - i) / 2});
+      if (vector && pairs > 0) {
+        interpolateHalvesAvx2(rx + sa, qx + sp, pairs);
+        interpolateHalvesAvx2(ry + sa, qy + sp, pairs);
+        interpolateHalvesAvx2(rz + sa, qz + sp, pairs);
+        sa += pairs;
+        sp += 2 * pairs;
+        i += 2 * pairs;
+        if (sp == rowSize) sp = 0;
+        if (i >= endI) break;
+      }
+    }
     const int64_t sb = sa + 1 == nx ? 0 : sa + 1;
     for (int t = 0; t < k && i < endI; ++t, ++i) {
       S ddx = rx[sa], ddy = ry[sa], ddz = rz[sa];
@@ -266,6 +308,8 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
   }
   const PatchWriter<S> out(patches, c);
   const size_t rowBase = size_t(patchWindow.storageRow(j) * rowSize);
+  if constexpr (kFast)
+    if (vector) return writePatchesAvx2(out, rowBase, qx, qy, qz, rowSize);
   for (int64_t q = 0; q < rowSize; ++q) {
     if constexpr (kFast) out.writeFast(rowBase + size_t(q), qx[q], qy[q], qz[q]);
     else out.write(rowBase + size_t(q), qx[q], qy[q], qz[q]);

@@ -417,20 +417,25 @@ void World<S>::updatePatchesFromDisplacement() {
     const PatchWriter<S> out(patches_, patchConsts_);
     const S *dx = dispX_.data(), *dy = dispY_.data(), *dz = dispZ_.data();
     pool_->run((grid_.countZ + rowsPerChunk_ - 1) / rowsPerChunk_, [&](int64_t c, int) {
-      const int64_t b1 = std::min(grid_.countZ, (c + 1) * rowsPerChunk_);
-      for (int64_t q = c * rowsPerChunk_ * grid_.countX; q < b1 * grid_.countX; ++q)
+      const int64_t q0 = c * rowsPerChunk_ * grid_.countX;
+      const int64_t q1 = std::min(grid_.countZ, (c + 1) * rowsPerChunk_) * grid_.countX;
+      if constexpr (ScalarTraits<S>::isFixed)
+        if (particleKernel_ == ParticleKernel::Avx2)
+          return writePatchesAvx2(out, size_t(q0), dx + q0, dy + q0, dz + q0, q1 - q0);
+      for (int64_t q = q0; q < q1; ++q)
         out.writeFast(size_t(q), dx[q], dy[q], dz[q]);  // same bits as write(): patch_state.h
     });
     return;
   }
+  const bool vector = particleKernel_ == ParticleKernel::Avx2;
   const LatticeWindow& pw = patchWindow_;
   const int64_t patchRowsPerChunk = std::max<int64_t>(1, kTargetChunkElements / pw.sizeI);
   pool_->run((pw.sizeJ + patchRowsPerChunk - 1) / patchRowsPerChunk, [&](int64_t c, int worker) {
     S* scratch = rowScratch_.data() + size_t(worker) * size_t(3 * (grid_.countX + pw.sizeI));
     const int64_t j1 = pw.originJ + std::min(pw.sizeJ, (c + 1) * patchRowsPerChunk);
     for (int64_t j = pw.originJ + c * patchRowsPerChunk; j < j1; ++j)
-      exactRowWeights_ && grid_.k == 2 ? updatePatchRow<S, 2>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch)
-      : exactRowWeights_ && grid_.k == 4 ? updatePatchRow<S, 4>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch)
+      exactRowWeights_ && grid_.k == 2 ? updatePatchRow<S, 2>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch, vector)
+      : exactRowWeights_ && grid_.k == 4 ? updatePatchRow<S, 4>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch, vector)
                                           : updatePatchRow<S>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch);
   });
 }
@@ -688,8 +693,9 @@ StepResult World<S>::step(const TickInput& input, StageObserver* observer) {
   const bool moved = runParticleRows(Stage::Integrate, [&](int64_t row, int64_t b, int64_t e) {
     const size_t windRow = size_t(grid_.window.latticeRow(row));  // the wind acts per lattice row
     const S dvx = rowAccel_.x[windRow], dvy = rowAccel_.y[windRow], dvz = rowAccel_.z[windRow];
-    return pbd ? advanceParticleRow<S, true>(particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_)
-               : advanceParticleRow<S, false>(particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_);
+    const ParticleKernel kernel = particleKernel_;
+    return pbd ? advanceParticleRow<S, true>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_)
+               : advanceParticleRow<S, false>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_);
   });
   if (moved && hasBodies) {
     integrateBodyPositions(bodies_, c.dt);

@@ -3,7 +3,8 @@
 //
 // Invariants (each one a test in tests/):
 //   * same scenario + same inputs => the same stateHash() after every tick, for any thread
-//     count, build type and compiler (fixed types; float/double: same binary only);
+//     count, build type, compiler and particle kernel (fixed types; float/double: same binary
+//     only);
 //   * saveState() -> restoreState() into a fresh world -> continue == never interrupted;
 //   * nothing inside step() reads a clock, a random generator or libm.
 #pragma once
@@ -22,6 +23,7 @@
 #include "sim/field/grass_field.h"
 #include "sim/field/markings.h"
 #include "sim/lod/edge_ring.h"
+#include "sim/particles/particle_row.h"
 #include "sim/particles/particles.h"
 #include "sim/patches/patch_state.h"
 #include "sim/scenario/scenario.h"
@@ -98,6 +100,10 @@ class SimWorld {
   /// Throws StateError when the bytes are not a state of this world's scenario and scalar.
   virtual void restoreState(std::span<const uint8_t> bytes) = 0;
   virtual void setThreads(int threads) = 0;
+  /// Which implementation runs the fused particle pass. Every kernel gives the same state bits
+  /// and fault reports; a kernel the CPU lacks falls back to the scalar reference.
+  virtual void setParticleKernel(ParticleKernel kernel) = 0;
+  virtual ParticleKernel particleKernel() const = 0;
   /// Fills `out` (reusing its storage) with the current tips and body poses.
   virtual void observe(Observation& out) const = 0;
   /// The scenario body (index into scenario.bodies.list) whose spec body `body` copies: its own
@@ -123,6 +129,11 @@ class World final : public SimWorld {
   std::vector<uint8_t> saveState() const override;
   void restoreState(std::span<const uint8_t> bytes) override;
   void setThreads(int threads) override;
+  void setParticleKernel(ParticleKernel kernel) override {
+    const bool vector = ScalarTraits<S>::isFixed && kernel == ParticleKernel::Avx2 && avx2KernelAvailable();
+    particleKernel_ = vector ? ParticleKernel::Avx2 : ParticleKernel::Scalar;
+  }
+  ParticleKernel particleKernel() const override { return particleKernel_; }
   void observe(Observation& out) const override;
   int32_t bodyTemplate(int64_t body) const override;
   bool bladeOn(int64_t body) const override;
@@ -173,6 +184,8 @@ class World final : public SimWorld {
 
   uint64_t configHash_ = 0;
   ConstraintMode constraintMode_ = ConstraintMode::Thesis;
+  /// The fused particle pass's implementation (float and double: always the reference).
+  ParticleKernel particleKernel_ = ScalarTraits<S>::isFixed ? defaultParticleKernel() : ParticleKernel::Scalar;
   GrassLattice<S> lattice_;
   PatchArrays<S> patches_;
   LatticeWindow patchWindow_;  ///< which patches patches_ holds (toroidal, like the particles)
