@@ -4,8 +4,8 @@
 // constraint modes, every row length up to a few blocks, on realistic states, on the exact
 // rounding boundaries of |d| and L / |d| (where the kernel's double guesses are wrong by one and
 // must hand the block to the reference), on particles at their anchor, and on states that
-// overflow. The patch stage (sim/patches/patch_row_avx2.cpp): the row blend and the patch writes
-// on edge and random values. Then whole worlds: every tick's hash and every patch's derived
+// overflow. The patch stage (sim/patches/patch_row_avx2.cpp): the row blend (1/4, 1/2, 3/4), the
+// k = 2 and 4 interpolation along x and the patch writes on edge and random values. Then whole worlds: every tick's hash and every patch's derived
 // state equal between the two kernels on the golden scenarios.
 #include <gtest/gtest.h>
 
@@ -428,9 +428,10 @@ TYPED_TEST(AvxKernel, PatchRowBlendMatchesTheUncheckedLerp) {
     a[i] = S::fromRaw(values[i]);
     b[i] = S::fromRaw(values[(i * 7 + 3) % n]);  // every edge value against others
   }
-  for (const auto& [m, k, t] : {std::array<int, 3>{1, 2, 1}, {1, 4, 2}, {2, 4, 1}}) {
+  // (quarters, k, t): the weight t / k as quarters
+  for (const auto& [quarters, k, t] : {std::array<int, 3>{2, 2, 1}, {2, 4, 2}, {1, 4, 1}, {3, 4, 3}}) {
     for (size_t len : {n, size_t(13), size_t(1), size_t(0)}) {  // tails of every length
-      blendRowsAvx2(a.data(), b.data(), out.data(), int64_t(len), m);
+      blendRowsAvx2(a.data(), b.data(), out.data(), int64_t(len), quarters);
       for (size_t i = 0; i < len; ++i) {
         const S expected = k == 2 ? unchecked::lerpByFraction<S, 2>(a[i], b[i], t)
                                   : unchecked::lerpByFraction<S, 4>(a[i], b[i], t);
@@ -455,6 +456,26 @@ TYPED_TEST(AvxKernel, PatchHalvesAlongXMatchTheUncheckedLerp) {
       ASSERT_EQ(out[2 * u + 1].raw(), half.raw()) << r[u].raw() << " to " << r[u + 1].raw();
     }
     EXPECT_EQ(out[2 * pairs].raw(), Raw<S>(12345)) << "wrote past the run";
+  }
+}
+
+TYPED_TEST(AvxKernel, PatchQuartersAlongXMatchTheUncheckedLerp) {
+  using S = TypeParam;
+  std::mt19937_64 rng(29);
+  const std::vector<Raw<S>> values = edgeAndRandomRaws<S>(rng, 1000);
+  std::vector<S> r;
+  for (Raw<S> v : values) r.push_back(S::fromRaw(v));
+  for (size_t quads : {r.size() - 1, size_t(11), size_t(1), size_t(0)}) {
+    std::vector<S> out(4 * quads + 1, S::fromRaw(Raw<S>(12345)));
+    interpolateQuartersAvx2(r.data(), out.data(), int64_t(quads));
+    for (size_t u = 0; u < quads; ++u) {
+      ASSERT_EQ(out[4 * u].raw(), r[u].raw()) << u;
+      for (int t = 1; t < 4; ++t) {
+        const S expected = unchecked::lerpByFraction<S, 4>(r[u], r[u + 1], t);
+        ASSERT_EQ(out[4 * u + size_t(t)].raw(), expected.raw()) << r[u].raw() << " to " << r[u + 1].raw() << " t " << t;
+      }
+    }
+    EXPECT_EQ(out[4 * quads].raw(), Raw<S>(12345)) << "wrote past the run";
   }
 }
 
@@ -562,6 +583,8 @@ INSTANTIATE_TEST_SUITE_P(Scenarios, KernelWorlds,
                                            WorldCase{"mower-field", "fx32", 2, false},
                                            WorldCase{"mower-field", "fx16", 1, false},
                                            WorldCase{"lod-crossing", "fx32", 2, false},
+                                           WorldCase{"lod-crossing", "fx16", 4, false},
+                                           WorldCase{"thesis-bodies", "fx32", 4, false},
                                            WorldCase{"hilly-meadow", "fx16", 4, true}),
                          [](const auto& info) {
                            const WorldCase& c = info.param;

@@ -1,9 +1,9 @@
 // The patch stage's loops (patch_state.h) for Fx32 and Fx16 in AVX2, with the unchecked loops'
 // exact bits (which are Fixed's bits, wrapping included):
-//   * blendRowsAvx2: a[i] + round((b[i] - a[i]) t / K) for the shift weights t / K = 1/2, 1/4
-//     (the blend of two particle rows for a patch row between them);
-//   * interpolateHalvesAvx2: k = 2 along x, a particle's value and the half-way blend to the
-//     next, interleaved into patch order;
+//   * blendRowsAvx2: a[i] + round((b[i] - a[i]) q / 4), q = 1, 2, 3 (the blend of two particle
+//     rows for a patch row between them; k = 2 is q = 2);
+//   * interpolateHalvesAvx2, interpolateQuartersAvx2: k = 2 and 4 along x, a particle's value
+//     and the blends towards the next, interleaved into patch order;
 //   * writePatchesAvx2: PatchWriter::writeFast over a run of patches (tip offsets, topY, tilt).
 // Fx32 four values per instruction, Fx16 eight. Everything here is integer arithmetic that
 // wraps like the scalar code, so there is nothing to verify and no fallback per block; the
@@ -103,16 +103,44 @@ SG_AVX2 __m256i shiftRound(__m256i d) {
   return _mm256_or_si256(L::shiftRight(x, M), fill);
 }
 
-template <class S, int M>
+/// Fixed's d * (3/4): round(3 d / 4), ties away from zero, computed on |d| = 4 m + r without
+/// the wide product: 3 m + (3 r + 2) / 4 (r = 0..3 gives 0, 1, 2, 2), then the sign. 3 m stays
+/// below 3 * 2^61 (and the result is within the format: |3 d / 4| < 2^63).
+template <class S>
+SG_AVX2 __m256i threeQuarters(__m256i d) {
+  using L = Lanes<S>;
+  __m256i negative, magnitude;
+  if constexpr (L::kBits == 64) {
+    negative = L::greater(_mm256_setzero_si256(), d);
+    magnitude = L::sub(_mm256_xor_si256(d, negative), negative);  // INT64_MIN: 2^63 as unsigned
+  } else {
+    magnitude = _mm256_abs_epi32(d);
+  }
+  const __m256i m = L::shiftRight(magnitude, 2);
+  const __m256i r = _mm256_and_si256(magnitude, L::all(3));
+  const __m256i rounded = L::shiftRight(L::add(L::add(r, L::shiftLeft(r, 1)), L::all(2)), 2);
+  const __m256i result = L::add(L::add(m, L::shiftLeft(m, 1)), rounded);
+  if constexpr (L::kBits == 64) return L::sub(_mm256_xor_si256(result, negative), negative);
+  else return _mm256_sign_epi32(result, d);  // d = 0 gives 0, which the product is
+}
+
+/// round((b - a) q / 4) for q = 1, 2, 3 quarters, as unchecked::lerpByFraction<S, 4> scales.
+template <class S, int Quarters>
+SG_AVX2 __m256i scaleByQuarters(__m256i d) {
+  if constexpr (Quarters == 1) return shiftRound<S, 2>(d);
+  else if constexpr (Quarters == 2) return shiftRound<S, 1>(d);
+  else return threeQuarters<S>(d);
+}
+
+template <class S, int Quarters>
 __attribute__((target("avx2"))) void blendRows(const S* a, const S* b, S* out, int64_t n) {
   using L = Lanes<S>;
   int64_t i = 0;
   for (; i + L::kCount <= n; i += L::kCount) {
     const __m256i va = load(a + i);
-    store(out + i, L::add(va, shiftRound<S, M>(L::sub(load(b + i), va))));
+    store(out + i, L::add(va, scaleByQuarters<S, Quarters>(L::sub(load(b + i), va))));
   }
-  for (; i < n; ++i) out[i] = S::fromRaw(unchecked::add(a[i].raw(), unchecked::shiftRound<typename S::RawType, M>(
-                                                                         unchecked::sub(b[i].raw(), a[i].raw()))));
+  for (; i < n; ++i) out[i] = unchecked::lerpByFraction<S, 4>(a[i], b[i], Quarters);
 }
 
 /// out[2u] = r[u], out[2u + 1] = blend(r[u], r[u + 1]) with weight 1/2, u in [0, pairs).
@@ -138,6 +166,43 @@ __attribute__((target("avx2"))) void interpolateHalves(const S* r, S* out, int64
   for (; u < pairs; ++u) {
     out[2 * u] = r[u];
     out[2 * u + 1] = unchecked::lerpByFraction<S, 2>(r[u], r[u + 1], 1);
+  }
+}
+
+/// out[4u + t] = blend(r[u], r[u + 1]) with weight t / 4, t = 0..3, u in [0, quads).
+template <class S>
+__attribute__((target("avx2"))) void interpolateQuarters(const S* r, S* out, int64_t quads) {
+  using L = Lanes<S>;
+  int64_t u = 0;
+  for (; u + L::kCount <= quads; u += L::kCount) {
+    const __m256i e0 = load(r + u);
+    const __m256i d = L::sub(load(r + u + 1), e0);
+    const __m256i e1 = L::add(e0, scaleByQuarters<S, 1>(d));
+    const __m256i e2 = L::add(e0, scaleByQuarters<S, 2>(d));
+    const __m256i e3 = L::add(e0, scaleByQuarters<S, 3>(d));
+    // Transpose: each particle's four patches side by side.
+    S* o = out + 4 * u;
+    if constexpr (L::kBits == 64) {
+      const __m256i t0 = _mm256_unpacklo_epi64(e0, e1), t1 = _mm256_unpackhi_epi64(e0, e1);
+      const __m256i t2 = _mm256_unpacklo_epi64(e2, e3), t3 = _mm256_unpackhi_epi64(e2, e3);
+      store(o, _mm256_permute2x128_si256(t0, t2, 0x20));
+      store(o + 4, _mm256_permute2x128_si256(t1, t3, 0x20));
+      store(o + 8, _mm256_permute2x128_si256(t0, t2, 0x31));
+      store(o + 12, _mm256_permute2x128_si256(t1, t3, 0x31));
+    } else {
+      const __m256i t0 = _mm256_unpacklo_epi32(e0, e1), t1 = _mm256_unpackhi_epi32(e0, e1);
+      const __m256i t2 = _mm256_unpacklo_epi32(e2, e3), t3 = _mm256_unpackhi_epi32(e2, e3);
+      const __m256i u0 = _mm256_unpacklo_epi64(t0, t2), u1 = _mm256_unpackhi_epi64(t0, t2);
+      const __m256i u2 = _mm256_unpacklo_epi64(t1, t3), u3 = _mm256_unpackhi_epi64(t1, t3);
+      store(o, _mm256_permute2x128_si256(u0, u1, 0x20));
+      store(o + 8, _mm256_permute2x128_si256(u2, u3, 0x20));
+      store(o + 16, _mm256_permute2x128_si256(u0, u1, 0x31));
+      store(o + 24, _mm256_permute2x128_si256(u2, u3, 0x31));
+    }
+  }
+  for (; u < quads; ++u) {
+    out[4 * u] = r[u];
+    for (int t = 1; t < 4; ++t) out[4 * u + t] = unchecked::lerpByFraction<S, 4>(r[u], r[u + 1], t);
   }
 }
 
@@ -169,14 +234,20 @@ __attribute__((target("avx2"))) int64_t writePatches(const PatchWriter<S>& w, si
 }  // namespace
 
 template <class S>
-void blendRowsAvx2(const S* a, const S* b, S* out, int64_t n, int m) {
-  if (m == 1) blendRows<S, 1>(a, b, out, n);
-  else blendRows<S, 2>(a, b, out, n);
+void blendRowsAvx2(const S* a, const S* b, S* out, int64_t n, int quarters) {
+  if (quarters == 1) blendRows<S, 1>(a, b, out, n);
+  else if (quarters == 2) blendRows<S, 2>(a, b, out, n);
+  else blendRows<S, 3>(a, b, out, n);
 }
 
 template <class S>
 void interpolateHalvesAvx2(const S* r, S* out, int64_t pairs) {
   interpolateHalves(r, out, pairs);
+}
+
+template <class S>
+void interpolateQuartersAvx2(const S* r, S* out, int64_t quads) {
+  interpolateQuarters(r, out, quads);
 }
 
 template <class S>
@@ -190,12 +261,15 @@ void writePatchesAvx2(const PatchWriter<S>& w, size_t first, const S* dx, const 
 #else
 
 template <class S>
-void blendRowsAvx2(const S* a, const S* b, S* out, int64_t n, int m) {
-  for (int64_t i = 0; i < n; ++i)
-    out[i] = S::fromRaw(unchecked::add(a[i].raw(), m == 1 ? unchecked::shiftRound<typename S::RawType, 1>(
-                                                                unchecked::sub(b[i].raw(), a[i].raw()))
-                                                          : unchecked::shiftRound<typename S::RawType, 2>(
-                                                                unchecked::sub(b[i].raw(), a[i].raw()))));
+void blendRowsAvx2(const S* a, const S* b, S* out, int64_t n, int quarters) {
+  for (int64_t i = 0; i < n; ++i) out[i] = unchecked::lerpByFraction<S, 4>(a[i], b[i], quarters);
+}
+template <class S>
+void interpolateQuartersAvx2(const S* r, S* out, int64_t quads) {
+  for (int64_t u = 0; u < quads; ++u) {
+    out[4 * u] = r[u];
+    for (int t = 1; t < 4; ++t) out[4 * u + t] = unchecked::lerpByFraction<S, 4>(r[u], r[u + 1], t);
+  }
 }
 template <class S>
 void interpolateHalvesAvx2(const S* r, S* out, int64_t pairs) {
@@ -215,6 +289,8 @@ template void blendRowsAvx2<Fx32>(const Fx32*, const Fx32*, Fx32*, int64_t, int)
 template void blendRowsAvx2<Fx16>(const Fx16*, const Fx16*, Fx16*, int64_t, int);
 template void interpolateHalvesAvx2<Fx32>(const Fx32*, Fx32*, int64_t);
 template void interpolateHalvesAvx2<Fx16>(const Fx16*, Fx16*, int64_t);
+template void interpolateQuartersAvx2<Fx32>(const Fx32*, Fx32*, int64_t);
+template void interpolateQuartersAvx2<Fx16>(const Fx16*, Fx16*, int64_t);
 template void writePatchesAvx2<Fx32>(const PatchWriter<Fx32>&, size_t, const Fx32*, const Fx32*, const Fx32*, int64_t);
 template void writePatchesAvx2<Fx16>(const PatchWriter<Fx16>&, size_t, const Fx16*, const Fx16*, const Fx16*, int64_t);
 

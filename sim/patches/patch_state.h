@@ -14,6 +14,7 @@
 #include <bit>
 #include <cstdint>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "sim/field/grass_field.h"
@@ -167,14 +168,18 @@ struct PatchWriter {
 
 /// AVX2 versions of the two contiguous loops below, for Fx32 and Fx16 (patch_row_avx2.cpp), with
 /// the same bits; call them only where the CPU has AVX2 (avx2KernelAvailable()).
-/// out[i] = a[i] + round((b[i] - a[i]) / 2^m), ties away from zero, m = 1 or 2: lerpByFraction
-/// for the weights 1/2 and 1/4 (and 2/4).
+/// out[i] = unchecked::lerpByFraction<S, 4>(a[i], b[i], quarters), quarters = 1, 2, 3 (the
+/// weight 1/2 of k = 2 is 2 quarters).
 template <class S>
-void blendRowsAvx2(const S* a, const S* b, S* out, int64_t n, int m);
+void blendRowsAvx2(const S* a, const S* b, S* out, int64_t n, int quarters);
 /// out[2u] = r[u], out[2u + 1] = lerpByFraction<S, 2>(r[u], r[u + 1], 1) for u in [0, pairs)
 /// (reads r[pairs]).
 template <class S>
 void interpolateHalvesAvx2(const S* r, S* out, int64_t pairs);
+/// out[4u + t] = lerpByFraction<S, 4>(r[u], r[u + 1], t) (t = 0: r[u]) for u in [0, quads)
+/// (reads r[quads]).
+template <class S>
+void interpolateQuartersAvx2(const S* r, S* out, int64_t quads);
 /// w.writeFast(first + q, dx[q], dy[q], dz[q]) for q in [0, count).
 template <class S>
 void writePatchesAvx2(const PatchWriter<S>& w, size_t first, const S* dx, const S* dy, const S* dz, int64_t count);
@@ -246,13 +251,12 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
     S* bx = scratch;
     S* by = scratch + nx;
     S* bz = scratch + 2 * nx;
-    // The shift weights 1/2 (K = 2, 4) and 1/4 (K = 4) vectorised; 3/4 is a product.
-    const int shift = K == 2 || (K == 4 && t == 2) ? 1 : K == 4 && t == 1 ? 2 : 0;
-    if (kFast && vector && shift != 0) {
+    if (kFast && vector) {
       if constexpr (kFast) {
-        blendRowsAvx2(rx, sx, bx, nx, shift);
-        blendRowsAvx2(ry, sy, by, nx, shift);
-        blendRowsAvx2(rz, sz, bz, nx, shift);
+        const int quarters = K == 2 ? 2 : t;  // the weight t / K in quarters
+        blendRowsAvx2(rx, sx, bx, nx, quarters);
+        blendRowsAvx2(ry, sy, by, nx, quarters);
+        blendRowsAvx2(rz, sz, bz, nx, quarters);
       }
     } else {
       for (int64_t a = 0; a < nx; ++a) {
@@ -276,17 +280,18 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
   int64_t sa = particles.storageColumn(patchWindow.originI / k);
   int64_t sp = patchWindow.storageColumn(patchWindow.originI);
   for (int64_t i = patchWindow.originI; i < endI;) {
-    if constexpr (kFast && K == 2) {
-      // The run up to the next wrap of either storage row, vectorised (all of it with the level
-      // of detail off); the scalar steps below cross the wrap.
-      const int64_t pairs = std::min({nx - 1 - sa, (rowSize - sp) / 2, (endI - i) / 2});
-      if (vector && pairs > 0) {
-        interpolateHalvesAvx2(rx + sa, qx + sp, pairs);
-        interpolateHalvesAvx2(ry + sa, qy + sp, pairs);
-        interpolateHalvesAvx2(rz + sa, qz + sp, pairs);
-        sa += pairs;
-        sp += 2 * pairs;
-        i += 2 * pairs;
+    if constexpr (kFast) {
+      // The run of whole particle steps up to the next wrap of either storage row, vectorised
+      // (all of it with the level of detail off); the scalar steps below cross the wrap.
+      const int64_t steps = std::min({nx - 1 - sa, (rowSize - sp) / K, (endI - i) / K});
+      if (vector && steps > 0) {
+        for (auto [r, q] : {std::pair{rx, qx}, std::pair{ry, qy}, std::pair{rz, qz}}) {
+          if constexpr (K == 2) interpolateHalvesAvx2(r + sa, q + sp, steps);
+          else interpolateQuartersAvx2(r + sa, q + sp, steps);
+        }
+        sa += steps;
+        sp += K * steps;
+        i += K * steps;
         if (sp == rowSize) sp = 0;
         if (i >= endI) break;
       }
