@@ -8,8 +8,9 @@
 // state (18 MB there) through memory three times (docs/performance.md, "Fused particle pass").
 //
 // Two implementations give the same bits: the scalar reference below, and for the fixed-point
-// scalars an AVX2 kernel (particle_row_avx2.cpp) that runs four particles per instruction and
-// hands any block it cannot prove exact to the reference (docs/performance.md, "Vector kernel").
+// scalars an AVX2 kernel (particle_row_avx2.cpp) that runs four (Fx32) or eight (Fx16) particles
+// per instruction and hands any block it cannot prove exact to the reference (docs/performance.md,
+// "Vector kernels").
 #pragma once
 
 #include <cstdint>
@@ -28,8 +29,9 @@ struct RowFault {
   Stage stage = Stage::Integrate;
 };
 
-/// Which implementation of the fused particle pass a world runs. Both give bit-identical state
-/// and the same fault reports; Avx2 applies to the fixed-point scalars on CPUs that have it.
+/// Which implementation of the hot loops a world runs: the fused particle pass here and the patch
+/// stage's loops (patches/patch_row_avx2.cpp). Both give bit-identical state and the same fault
+/// reports; Avx2 applies to the fixed-point scalars on CPUs that have it.
 enum class ParticleKernel : uint8_t { Scalar = 0, Avx2 = 1 };
 
 /// "scalar" or "avx2".

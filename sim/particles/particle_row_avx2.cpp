@@ -2,7 +2,7 @@
 // exact bits: Fx32 four particles per block (one Q32.32 value per 64-bit lane), Fx16 eight
 // (one Q16.16 value per 32-bit lane).
 //
-// How it stays exact (docs/performance.md, "Vector kernel"):
+// How it stays exact (docs/performance.md, "Vector kernels"):
 //   * Products are formed on magnitudes from exact 32 x 32 -> 64 partial products (AVX2 has no
 //     64-bit multiply) and rounded like Fixed::operator* (to nearest, ties away from zero).
 //     Where a product could leave the format, its operand or its result is checked.
