@@ -166,7 +166,7 @@ struct PatchWriter {
   }
 };
 
-/// AVX2 versions of the two contiguous loops below, for Fx32 and Fx16 (patch_row_avx2.cpp), with
+/// AVX2 versions of the loops below, for Fx32 and Fx16 (patch_row_avx2.cpp), with
 /// the same bits; call them only where the CPU has AVX2 (avx2KernelAvailable()).
 /// out[i] = unchecked::lerpByFraction<S, 4>(a[i], b[i], quarters), quarters = 1, 2, 3 (the
 /// weight 1/2 of k = 2 is 2 quarters).
@@ -215,8 +215,8 @@ inline bool rowWeightsAreExact(const PatchStateConstants<S>& c) {
 /// covers patch columns [k originI, k (originI + sizeI - 1)] at most, so every patch lies between
 /// two held particles. `scratch` holds 3 * (particles.sizeI + patchWindow.sizeI) values. K = 0 takes k and the weights
 /// from `c`; K = c.k (2 or 4, when rowWeightsAreExact) uses constant weights: the same bits,
-/// about a third fewer instructions. `vector` (K = 2, 4 and the fixed types only) runs the row blend
-/// and the patch writes with the AVX2 loops: the same bits again.
+/// about a third fewer instructions. `vector` (K = 2, 4 and the fixed types only) runs the row
+/// blend, the interpolation along x and the patch writes with the AVX2 loops: the same bits again.
 template <class S, int K = 0>
 inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWindow, int64_t j,
                            const LatticeWindow& particles, const std::vector<S>& dx, const std::vector<S>& dy,

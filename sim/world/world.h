@@ -100,8 +100,9 @@ class SimWorld {
   /// Throws StateError when the bytes are not a state of this world's scenario and scalar.
   virtual void restoreState(std::span<const uint8_t> bytes) = 0;
   virtual void setThreads(int threads) = 0;
-  /// Which implementation runs the fused particle pass. Every kernel gives the same state bits
-  /// and fault reports; a kernel the CPU lacks falls back to the scalar reference.
+  /// Which implementation runs the hot loops (the fused particle pass and the patch stage). Every
+  /// kernel gives the same state bits and fault reports; a kernel the CPU lacks falls back to the
+  /// scalar reference.
   virtual void setParticleKernel(ParticleKernel kernel) = 0;
   virtual ParticleKernel particleKernel() const = 0;
   /// Fills `out` (reusing its storage) with the current tips and body poses.
