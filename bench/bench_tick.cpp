@@ -1,6 +1,8 @@
 // One full tick, per scalar, field size, interpolation k and thread count (issue: core).
 // Counters: patch_steps/s (patches advanced per second) and ticks/s.
 //   build/release/bench/simgrass_bench --benchmark_filter=Tick
+#include <cstdio>
+#include "replay/kernel_environment.h"
 #include <benchmark/benchmark.h>
 
 #include <map>
@@ -49,4 +51,15 @@ BENCHMARK_CAPTURE(BM_Tick, double, sg::ScalarKind::Double)->Apply(sizes);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// BENCHMARK_MAIN with SIMGRASS_KERNEL applied first (the core reads no environment).
+int main(int argc, char** argv) {
+  if (!sg::applyKernelEnvironment()) {
+    std::fprintf(stderr, "simgrass_bench: SIMGRASS_KERNEL: expected scalar, avx2 or auto\n");
+    return 2;
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -8,7 +8,9 @@
 #include "replay/format/sgr_reader.h"
 #include "replay/player.h"
 #include "replay/recorder.h"
+#include "sim/state/byte_order.h"
 #include "tests/cli_support.h"
+#include "tests/state_sections.h"
 #include "tests/test_support.h"
 
 namespace sg {
@@ -334,24 +336,31 @@ TEST(BodyInputs, SaveAfterSpawnRestoreIntoAFreshWorldContinuesBitIdentically) {
   EXPECT_TRUE(busy->bladeOn(1));
 }
 
-TEST(BodyInputs, NoBodyInputMeansTheStateBytesOfBefore) {
-  // Without spawns or switched-off blades nothing is appended: the state ends with the mower
-  // cuts (the scenario has no level-of-detail window), as it always did.
+TEST(BodyInputs, BladeSwitchesAndSpawnsLiveInTheirSections) {
+  // A switched-off blade is a flag of its body's record, a spawn a SPWN entry: the state's size
+  // changes only with the number of bodies.
   const Scenario s = mowerScenario();
   auto w = makeTyped<Fx32>(s);
   stepN(*w, 5, command(1, BodyCommandKind::MowerOn));
-  const std::vector<uint8_t> bytes = w->saveState();
-  uint64_t edits;
-  std::memcpy(&edits, bytes.data() + bytes.size() - 16 * w->cuts().size() - 8, 8);
-  EXPECT_EQ(edits, w->cuts().size());
+  const std::vector<uint8_t> on = w->saveState();
+  const test::StateSection spawns = test::findSection(on, "SPWN");
+  EXPECT_EQ(spawns.length, 4u);
+  EXPECT_EQ(loadLE<uint32_t>(on.data() + spawns.payloadAt), 0u);
+  const test::StateSection bodies = test::findSection(on, "BODY");
+  const size_t record = 13 * sizeof(Fx32) + 8;
+  ASSERT_EQ(bodies.length, 2 * record);
+  const size_t mowerFlags = bodies.payloadAt + record + 13 * sizeof(Fx32) + 4;
+  EXPECT_EQ(on[mowerFlags] & 2, 0);
   ASSERT_TRUE(w->step(command(1, BodyCommandKind::MowerOff)).ok);
   const std::vector<uint8_t> off = w->saveState();
-  // magic + spawn count 0 + blade count 1 + body 1.
-  EXPECT_EQ(off.size(), bytes.size() + 8 + 8 + 8 + 8);
-  EXPECT_EQ(std::string(reinterpret_cast<const char*>(off.data()) + bytes.size(), 8), "SGBODYX1");
+  EXPECT_EQ(off.size(), on.size());
+  EXPECT_EQ(off[mowerFlags] & 2, 2) << "the mower's record says its blade is off";
+  ASSERT_TRUE(w->step(spawnAndSwitch(0)).ok);
+  const std::vector<uint8_t> spawned = w->saveState();
+  EXPECT_EQ(loadLE<uint32_t>(spawned.data() + test::findSection(spawned, "SPWN").payloadAt), uint32_t(w->counts().bodies - 2));
 }
 
-TEST(BodyInputs, DamagedBodyInputBlocksGiveAStateErrorNeverACrash) {
+TEST(BodyInputs, DamagedBodyInputsGiveAStateErrorNeverACrash) {
   const Scenario s = mowerScenario();
   auto w = makeTyped<Fx32>(s);
   for (int64_t t = 0; t < 10; ++t) ASSERT_TRUE(w->step(spawnAndSwitch(t)).ok);
@@ -368,36 +377,36 @@ TEST(BodyInputs, DamagedBodyInputBlocksGiveAStateErrorNeverACrash) {
     }
     EXPECT_EQ(target->stateHash(), before) << "a failed restore changes nothing";
   };
-  // The block: magic, spawn count 2, 2 x 32 bytes, blade count 1, body 2 (= 96 bytes).
-  const size_t blockAt = good.size() - 96;
-  ASSERT_EQ(std::string(reinterpret_cast<const char*>(good.data()) + blockAt, 8), "SGBODYX1");
+  ASSERT_EQ(w->counts().bodies, 4);
+  const test::StateSection spawns = test::findSection(good, "SPWN");
+  const test::StateSection bodies = test::findSection(good, "BODY");
+  ASSERT_EQ(loadLE<uint32_t>(good.data() + spawns.payloadAt), 2u);
   auto bad = good;
-  bad[blockAt] = 'X';
-  expectError(bad, "SGBODYX1");
-  bad = good;
-  bad[blockAt + 8] = 3;
+  bad[spawns.payloadAt] = 3;
   expectError(bad, "2 spawned bodies");
   bad = good;
-  bad[blockAt + 16] = 7;  // template 7 of 2
+  bad[spawns.payloadAt + 4] = 7;  // template 7 of 2
   expectError(bad, "spawn template between 0 and 1");
   bad = good;
-  bad[good.size() - 8] = 0;  // body 0 is a ball, not a mower
+  bad[bodies.payloadAt + 13 * sizeof(Fx32) + 4] |= 2;  // body 0 is a ball, not a mower
   expectError(bad, "no mower");
   bad = good;
-  bad[14] = 70;  // header body count
+  bad[52] = 70;  // header body count
   expectError(bad, "2 to 64 bodies, got 70");
   bad = good;
-  bad[14] = 2;  // two bodies, but a block that spawns two more
+  bad[52] = 2;  // two bodies, but a body section and spawns for four
   expectError(bad, "");
-  for (size_t cut = 1; cut <= 96; ++cut) expectError({good.begin(), good.end() - ptrdiff_t(cut)}, "");
-  // Every single-byte change of the block is either refused or a valid state (never a crash).
-  for (size_t i = blockAt; i < good.size(); ++i) {
+  for (size_t cut = 1; cut <= 200; ++cut) expectError({good.begin(), good.end() - ptrdiff_t(cut)}, "");
+  // Every single-byte change of the body and spawn sections is either refused or a state that
+  // steps, or fails its step with a reported fault (a flipped pose bit can overflow): never a crash.
+  for (size_t i = bodies.tagAt; i < spawns.payloadAt + spawns.length; ++i) {
     bad = good;
     bad[i] ^= 0x5a;
     try {
       auto probe = makeTyped<Fx32>(s);
       probe->restoreState(bad);
-      ASSERT_TRUE(probe->step(TickInput{}).ok);
+      const StepResult r = probe->step(TickInput{});
+      if (!r.ok) EXPECT_NE(r.error.message().find("simulation error at tick"), std::string::npos);
     } catch (const StateError&) {
     }
   }

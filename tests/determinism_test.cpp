@@ -3,9 +3,11 @@
 // for states that do not belong to the world.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "tests/state_sections.h"
 #include "tests/test_support.h"
 
 namespace sg {
@@ -178,41 +180,85 @@ class BadState : public ::testing::Test {
   std::vector<uint8_t> good;
 };
 
-TEST_F(BadState, TruncatedHeader) { expectError({good.begin(), good.begin() + 10}, 10, "header"); }
+// Offsets in a state (sim/state/state_format.h): magic 0..7, HEAD tag 8, length 12, payload 20:
+// version 20, scalar 24, k 25, fingerprint 28, tick 36, particle count 44, body count 52.
+TEST_F(BadState, TruncatedMagic) { expectError({good.begin(), good.begin() + 5}, 5, "magic"); }
 TEST_F(BadState, WrongMagic) {
   auto b = good;
   b[0] = 'X';
   expectError(b, 0, "magic");
 }
+TEST_F(BadState, AVersionOneStateNamesItsVersion) {
+  auto b = good;
+  b[7] = '1';
+  expectError(b, 7, "version 2");
+}
+TEST_F(BadState, TruncatedHeadSection) { expectError({good.begin(), good.begin() + 30}, 12, "length for section 'HEAD'"); }
 TEST_F(BadState, WrongVersion) {
   auto b = good;
-  b[8] = 99;
-  expectError(b, 8, "version");
+  b[20] = 99;
+  expectError(b, 20, "version");
 }
 TEST_F(BadState, WrongScalar) {
   auto b = good;
-  b[12] = uint8_t(ScalarKind::Fx16);
-  expectError(b, 12, "fx32");
+  b[24] = uint8_t(ScalarKind::Fx16);
+  expectError(b, 24, "fx32");
 }
 TEST_F(BadState, OtherScenario) {
   auto b = good;
-  b[16] ^= 1;
-  expectError(b, 16, "same scenario");
+  b[28] ^= 1;
+  expectError(b, 28, "same scenario");
 }
-TEST_F(BadState, TruncatedBody) {
+TEST_F(BadState, NegativeTick) {
   auto b = good;
-  b.resize(b.size() - 100);
-  expectError(b, b.size(), "bytes of state");
+  b[43] = 0x80;
+  expectError(b, 36, "non-negative tick");
+}
+TEST_F(BadState, ParticleCount) {
+  auto b = good;
+  b[44] ^= 1;
+  expectError(b, 44, "particles");
+}
+TEST_F(BadState, SectionOutOfOrder) {
+  auto b = good;
+  const test::StateSection part = test::findSection(b, "PART");
+  std::memcpy(b.data() + part.tagAt, "BODY", 4);
+  expectError(b, part.tagAt, "section 'PART', got 'BODY'");
+}
+TEST_F(BadState, SectionOfTheWrongSize) {
+  auto b = good;
+  const test::StateSection part = test::findSection(b, "PART");
+  b[part.tagAt + 4] ^= 8;
+  expectError(b, part.tagAt + 4, "section 'PART' of");
 }
 TEST_F(BadState, ExtraBytes) {
   auto b = good;
   b.push_back(0);
-  expectError(b, good.size(), "bytes of state");
+  expectError(b, good.size(), "end of the state");
 }
-TEST_F(BadState, ParticleCount) {
-  auto b = good;
-  b[32] ^= 1;
-  expectError(b, 32, "particles");
+TEST_F(BadState, EveryTruncationIsRefusedAtOrBeforeTheCut) {
+  auto fresh = build({"thesis-meadow", "fx32"}, 1);
+  const uint64_t before = fresh->stateHash();
+  for (size_t cut = 0; cut < good.size(); cut += (cut < 200 || good.size() - cut < 200) ? 1 : 997) {
+    try {
+      fresh->restoreState(std::span<const uint8_t>(good.data(), cut));
+      ADD_FAILURE() << "accepted a state cut at byte " << cut;
+    } catch (const StateError& e) {
+      EXPECT_LE(e.offset(), cut) << e.what();
+    }
+  }
+  EXPECT_EQ(fresh->stateHash(), before) << "a refused state changes nothing";
+}
+TEST_F(BadState, FieldsAreLittleEndianWhateverTheHost) {
+  // The canonical form: tick and particle count read byte by byte, low byte first.
+  uint64_t tick = 0, particles = 0;
+  for (int i = 7; i >= 0; --i) {
+    tick = tick << 8 | good[size_t(36 + i)];
+    particles = particles << 8 | good[size_t(44 + i)];
+  }
+  EXPECT_EQ(int64_t(tick), world->tick());
+  EXPECT_EQ(int64_t(particles), world->counts().particles());
+  EXPECT_EQ(std::string(reinterpret_cast<const char*>(good.data()), 12), std::string("SGSTATE2HEAD"));
 }
 TEST_F(BadState, FailedRestoreLeavesTheWorldUsable) {
   auto b = good;

@@ -11,7 +11,9 @@
 #include "replay/format/sgr_reader.h"
 #include "replay/player.h"
 #include "replay/recorder.h"
+#include "sim/state/byte_order.h"
 #include "tests/cli_support.h"
+#include "tests/state_sections.h"
 #include "tests/test_support.h"
 
 namespace sg {
@@ -316,6 +318,50 @@ TEST(ReplayCli, RecordVerifySeekExportAndInfo) {
   EXPECT_EQ(tooFar.exitCode, 2);
   EXPECT_TRUE(isOneLine(tooFar.err));
   EXPECT_NE(tooFar.err.find("--to: expected a tick from 0 to 40"), std::string::npos) << tooFar.err;
+}
+
+TEST(ReplayCli, ExportStateAsJsonHoldsTheBinaryStatesNumbers) {
+  TempDir dir;
+  const std::string sgr = dir.file("b.sgr");
+  ASSERT_EQ(runCli("record " + quote(test::sourcePath("scenarios/thesis-bodies.json")) + " -o " + quote(sgr) +
+                   " --ticks 30 --json").exitCode, 0);
+  const CliResult bin = runCli("replay " + quote(sgr) + " --to 22 --export-state " + quote(dir.file("s.bin")));
+  ASSERT_EQ(bin.exitCode, 0) << bin.describe();
+  const CliResult js = runCli("replay " + quote(sgr) + " --to 22 --export-state " + quote(dir.file("s.json")));
+  ASSERT_EQ(js.exitCode, 0) << js.describe();
+  const std::string raw = readFile(dir.file("s.bin"));
+  const std::vector<uint8_t> state(raw.begin(), raw.end());
+  const json s = json::parse(readFile(dir.file("s.json")));
+  EXPECT_EQ(s["format"], "simgrass-state/2");
+  EXPECT_EQ(s["tick"], 22);
+  EXPECT_EQ(s["scalar"], "fx32");
+  EXPECT_EQ(loadLE<int64_t>(state.data() + 36), 22);
+  // Every particle position and velocity is the binary state's Q32.32 value (the scenario has no
+  // level-of-detail window, so storage order is lattice order).
+  const int64_t n = s["particles"]["countX"].get<int64_t>() * s["particles"]["countZ"].get<int64_t>();
+  ASSERT_EQ(loadLE<int64_t>(state.data() + 44), n);
+  const test::StateSection part = test::findSection(state, "PART");
+  const auto& position = s["particles"]["position"];
+  const auto& velocity = s["particles"]["velocity"];
+  ASSERT_EQ(int64_t(position.size()), 3 * n);
+  for (int64_t q = 0; q < n; q += 97)
+    for (int a = 0; a < 3; ++a) {
+      const double p = double(loadLE<int64_t>(state.data() + part.payloadAt + 8 * (a * n + q))) / 4294967296.0;
+      const double v = double(loadLE<int64_t>(state.data() + part.payloadAt + 8 * ((3 + a) * n + q))) / 4294967296.0;
+      EXPECT_EQ(position[size_t(3 * q + a)].get<double>(), p) << "particle " << q;
+      EXPECT_EQ(velocity[size_t(3 * q + a)].get<double>(), v) << "particle " << q;
+    }
+  const test::StateSection bodies = test::findSection(state, "BODY");
+  ASSERT_EQ(s["bodies"].size(), bodies.length / (13 * 8 + 8));
+  for (size_t b = 0; b < s["bodies"].size(); ++b)
+    for (int a = 0; a < 3; ++a)
+      EXPECT_EQ(s["bodies"][b]["position"][size_t(a)].get<double>(),
+                double(loadLE<int64_t>(state.data() + bodies.payloadAt + b * (13 * 8 + 8) + 8 * size_t(a))) / 4294967296.0);
+  EXPECT_EQ(int64_t(s["patches"]["tipOffset"].size()), 3 * s["patches"]["countX"].get<int64_t>() * s["patches"]["countZ"].get<int64_t>());
+  // A folder that does not exist: one line, exit 2, nothing left behind.
+  const CliResult bad = runCli("replay " + quote(sgr) + " --to 22 --export-state " + quote(dir.file("no/such/s.json")));
+  EXPECT_EQ(bad.exitCode, 2);
+  EXPECT_TRUE(isOneLine(bad.err)) << bad.err;
 }
 
 TEST(ReplayCli, RecordWithAnInputTrackAndAVariant) {

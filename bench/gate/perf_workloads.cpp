@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "replay/kernel_environment.h"
 #include "replay/format/sgr_reader.h"
 #include "replay/player.h"
 #include "replay/recorder.h"
@@ -183,6 +184,10 @@ int main(int argc, char** argv) {
   app.add_flag("--build-info", info, "Print the compiler and build type this binary was built with");
   app.add_flag("--json", json, "Machine-readable output");
   CLI11_PARSE(app, argc, argv);
+  if (!sg::applyKernelEnvironment()) {
+    std::fprintf(stderr, "simgrass_perf_workloads: SIMGRASS_KERNEL: expected scalar, avx2 or auto\n");
+    return 2;
+  }
 
   if (info) {
     const char* kernel = sg::particleKernelName(sg::defaultParticleKernel());

@@ -10,11 +10,16 @@
 #include "replay/cli/replay_command.h"
 #include "replay/cli/run_command.h"
 #include "replay/cli/sweep_command.h"
+#include "replay/kernel_environment.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"SimGrass: deterministic fixed-point grass physics testbed", "simgrass"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("simgrass ") + SIMGRASS_VERSION);
+  if (!sg::applyKernelEnvironment()) {
+    std::fprintf(stderr, "simgrass: SIMGRASS_KERNEL: expected scalar, avx2 or auto\n");
+    return 2;
+  }
   int exitCode = 0;
   sg::addRunCommand(app, &exitCode);
   sg::addRecordCommand(app, &exitCode);

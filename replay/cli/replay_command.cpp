@@ -1,12 +1,15 @@
 #include "replay/cli/replay_command.h"
 
+#include <filesystem>
 #include <chrono>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "replay/cli/cli_common.h"
+#include "replay/output_file.h"
 #include "replay/player.h"
+#include "replay/state_export.h"
 #include "replay/progress.h"
 
 namespace sg {
@@ -139,11 +142,19 @@ int replay(const ReplayOptions& o) {
     code = kExitMismatch;
   }
   if (!o.exportState.empty()) {
-    const std::vector<uint8_t> state = player->world().saveState();
-    std::ofstream f(o.exportState, std::ios::binary);
-    f.write(reinterpret_cast<const char*>(state.data()), std::streamsize(state.size()));
-    if (!f) {
-      std::fprintf(stderr, "simgrass replay: %s: cannot write the state\n", o.exportState.c_str());
+    // .json: the documented plain-number form; anything else: the binary state (SGSTATE2).
+    const bool asJson = std::filesystem::path(o.exportState).extension() == ".json";
+    std::string error;
+    bool written;
+    if (asJson) {
+      StateExport state;
+      player->world().exportState(state);
+      written = writeFileAtomic(o.exportState, stateExportJson(state).dump() + "\n", &error);
+    } else {
+      written = writeFileAtomic(o.exportState, player->world().saveState(), &error);
+    }
+    if (!written) {
+      std::fprintf(stderr, "simgrass replay: %s\n", error.c_str());
       return kExitBadInput;
     }
     out["exportedState"] = o.exportState;
@@ -166,7 +177,7 @@ void addReplayCommand(CLI::App& app, int* exitCode) {
   cmd->add_option("recording", o->file, "Recording (.sgr)")->required();
   cmd->add_flag("--verify", o->verify, "Recompute every recorded hash; report the first tick that differs (exit 1)");
   cmd->add_option("--to", o->to, "Seek to this tick through the nearest snapshot")->check(CLI::Range(int64_t(0), int64_t(1) << 40));
-  cmd->add_option("--export-state", o->exportState, "Write the state reached (SGSTATE1 bytes) to this file");
+  cmd->add_option("--export-state", o->exportState, "Write the state reached to this file: NAME.json the documented JSON form, any other name the binary state (docs/state-format.md)");
   cmd->add_option("--threads", o->threads, "Worker threads (the result is identical for any count)")->check(CLI::Range(1, 256));
   cmd->add_flag("--info", o->info, "Print what the recording holds without simulating");
   cmd->add_flag("--json", o->json, "Machine-readable output");

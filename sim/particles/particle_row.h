@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "sim/particles/integrate.h"
+#include "sim/particles/particle_kernel.h"
 #include "sim/particles/rod_constraint.h"
 #include "sim/patches/patch_state.h"
 #include "sim/world/stage.h"
@@ -29,18 +30,7 @@ struct RowFault {
   Stage stage = Stage::Integrate;
 };
 
-/// Which implementation of the hot loops a world runs: the fused particle pass here and the patch
-/// stage's loops (patches/patch_row_avx2.cpp). Both give bit-identical state and the same fault
-/// reports; Avx2 applies to the fixed-point scalars on CPUs that have it.
-enum class ParticleKernel : uint8_t { Scalar = 0, Avx2 = 1 };
 
-/// "scalar" or "avx2".
-const char* particleKernelName(ParticleKernel kernel);
-/// Whether this CPU runs the AVX2 kernel.
-bool avx2KernelAvailable();
-/// The kernel a new world uses: AVX2 where available, unless the environment variable
-/// SIMGRASS_KERNEL=scalar asks for the reference (read once per process).
-ParticleKernel defaultParticleKernel();
 
 /// The reference: integrates, projects and measures particles [begin, end) of one row;
 /// (dvx, dvy, dvz) is the row's (a + F/m) dt. Writes the tip displacement p - anchor - (0, L, 0)

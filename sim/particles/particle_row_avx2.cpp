@@ -16,6 +16,7 @@
 //     cases and anything out of range get the reference's bits and its fault report.
 // A guess that is off only costs a block its speed, never its bits. The functions carry
 // target("avx2") and are called only when the CPU has AVX2 (particle_row.h picks the kernel).
+#include <atomic>
 #include <cstdlib>
 #include <cstring>
 #include <type_traits>
@@ -457,14 +458,18 @@ RowFault advanceParticleRowAvx2(ParticleArrays<S>& p, int64_t begin, int64_t end
 
 #endif
 
+namespace {
+// Process-wide choice for worlds built from now on (setDefaultParticleKernel); relaxed is enough:
+// it is read when a world is built, and a world's kernel is fixed from then on.
+std::atomic<uint8_t> gDefaultKernel{uint8_t(ParticleKernel::Avx2)};
+}  // namespace
+
 ParticleKernel defaultParticleKernel() {
-  static const ParticleKernel kernel = [] {
-    const char* env = std::getenv("SIMGRASS_KERNEL");
-    if (env && std::strcmp(env, "scalar") == 0) return ParticleKernel::Scalar;
-    return avx2KernelAvailable() ? ParticleKernel::Avx2 : ParticleKernel::Scalar;
-  }();
-  return kernel;
+  const auto wanted = ParticleKernel(gDefaultKernel.load(std::memory_order_relaxed));
+  return wanted == ParticleKernel::Avx2 && avx2KernelAvailable() ? ParticleKernel::Avx2 : ParticleKernel::Scalar;
 }
+
+void setDefaultParticleKernel(ParticleKernel kernel) { gDefaultKernel.store(uint8_t(kernel), std::memory_order_relaxed); }
 
 #define SG_INSTANTIATE_AVX2_ROW(S, PBD)                                                                              \
   template RowFault advanceParticleRowAvx2<S, PBD>(ParticleArrays<S>&, int64_t, int64_t, S, S, S,                  \

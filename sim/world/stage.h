@@ -8,6 +8,7 @@ namespace sg {
 
 enum class Stage : uint8_t {
   Window = 0,       ///< level-of-detail window follows the camera           (sim/lod)
+  Input,            ///< recorded body commands applied                      (sim/bodies)
   Wind,             ///< per-row wind force and particle acceleration        (sim/wind)
   Collision,        ///< body-body and body-terrain contacts                 (sim/collision)
   Response,         ///< gravity, contact impulses, projection, grass push   (sim/collision)
@@ -21,6 +22,7 @@ enum class Stage : uint8_t {
 inline const char* stageName(Stage s) {
   switch (s) {
     case Stage::Window: return "window";
+    case Stage::Input: return "input";
     case Stage::Wind: return "wind";
     case Stage::Collision: return "collision";
     case Stage::Response: return "response";

@@ -31,91 +31,10 @@
 #include "sim/wind/wind.h"
 #include "sim/world/chunk_pool.h"
 #include "sim/world/stage.h"
+#include "sim/world/sim_world.h"
 #include "sim/world/tick_input.h"
 
 namespace sg {
-
-/// A simulation fault: arithmetic that did not fit the scalar, reported with where it happened.
-struct SimError {
-  int64_t tick = -1;
-  Stage stage = Stage::Count;
-  int64_t particle = -1;  ///< particle index, -1 if not particle-specific
-  int32_t body = -1;      ///< body index, -1 if not body-specific
-  int64_t latticeI = 0, latticeJ = 0;  ///< patch coordinates of that particle
-  std::string what;        ///< "fixed-point overflow", "non-finite value", ...
-  std::string message() const;
-};
-
-struct StepResult {
-  bool ok = true;
-  SimError error;
-};
-
-/// A malformed or mismatched saved state; names the byte offset and what was expected.
-class StateError : public std::runtime_error {
- public:
-  StateError(uint64_t offset, const std::string& expected);
-  uint64_t offset() const { return offset_; }
- private:
-  uint64_t offset_;
-};
-
-struct WorldCounts {
-  int64_t patchesX = 0, patchesZ = 0;      ///< the field
-  int64_t particlesX = 0, particlesZ = 0;  ///< simulated (the window's, with the level of detail on)
-  int interpolation = 1;
-  int threads = 1;
-  int64_t bodies = 0;
-  int64_t contacts = 0;  ///< body contacts found in the last tick
-  bool lodWindow = false;                 ///< the level-of-detail window is on
-  int64_t windowPatchesX = 0, windowPatchesZ = 0;  ///< simulated patches (the field when off)
-  int64_t windowOriginI = 0, windowOriginJ = 0;    ///< lattice patch of the window's first corner
-  int64_t patches() const { return patchesX * patchesZ; }
-  int64_t simulatedPatches() const { return windowPatchesX * windowPatchesZ; }
-  int64_t particles() const { return particlesX * particlesZ; }
-};
-
-/// What diff and compare measure, converted to double: every tuft's tip and every body's pose.
-struct Observation {
-  int64_t tick = 0;
-  int64_t patchesX = 0, patchesZ = 0;
-  std::vector<double> tipX, tipY, tipZ;  ///< per patch (row-major, i fastest): top-vertex centre, m
-  std::vector<double> bodyPosition;      ///< 3 per body, m
-  std::vector<double> bodyOrientation;   ///< 4 per body (w, x, y, z)
-  int64_t contacts = 0;                  ///< body contacts found in the last tick
-};
-
-/// Scalar-erased interface used by tools (command line, replay, viewer).
-class SimWorld {
- public:
-  virtual ~SimWorld() = default;
-  virtual ScalarKind scalar() const = 0;
-  virtual int64_t tick() const = 0;
-  virtual WorldCounts counts() const = 0;
-  /// Advances one tick. After a fault the world stays failed and every later call fails too.
-  virtual StepResult step(const TickInput& input, StageObserver* observer = nullptr) = 0;
-  /// xxHash3-64 of the canonical little-endian serialisation (the same bytes as saveState()).
-  virtual uint64_t stateHash() const = 0;
-  virtual std::vector<uint8_t> saveState() const = 0;
-  /// Throws StateError when the bytes are not a state of this world's scenario and scalar.
-  virtual void restoreState(std::span<const uint8_t> bytes) = 0;
-  virtual void setThreads(int threads) = 0;
-  /// Which implementation runs the hot loops (the fused particle pass and the patch stage). Every
-  /// kernel gives the same state bits and fault reports; a kernel the CPU lacks falls back to the
-  /// scalar reference.
-  virtual void setParticleKernel(ParticleKernel kernel) = 0;
-  virtual ParticleKernel particleKernel() const = 0;
-  /// Fills `out` (reusing its storage) with the current tips and body poses.
-  virtual void observe(Observation& out) const = 0;
-  /// The scenario body (index into scenario.bodies.list) whose spec body `body` copies: its own
-  /// index for a scenario body, the Spawn command's template for a spawned one; -1 if no such body.
-  virtual int32_t bodyTemplate(int64_t body) const = 0;
-  /// Whether body `body` is a mower whose blade is on (MowerOn/MowerOff; mowers start on).
-  virtual bool bladeOn(int64_t body) const = 0;
-};
-
-/// Builds a world for scenario.scalar. Throws ScenarioError when the scenario does not fit it.
-std::unique_ptr<SimWorld> makeWorld(const Scenario& scenario, int threads = 1, uint64_t memoryLimitBytes = 0);
 
 template <class S>
 class World final : public SimWorld {
@@ -135,6 +54,7 @@ class World final : public SimWorld {
     particleKernel_ = vector ? ParticleKernel::Avx2 : ParticleKernel::Scalar;
   }
   ParticleKernel particleKernel() const override { return particleKernel_; }
+  void exportState(StateExport& out) const override;
   void observe(Observation& out) const override;
   int32_t bodyTemplate(int64_t body) const override;
   bool bladeOn(int64_t body) const override;
@@ -163,6 +83,15 @@ class World final : public SimWorld {
   void updatePatchesFromDisplacement();  ///< the patches from dispX_/dispY_/dispZ_
 
  private:
+  // The stages of step() (world_step.cpp), in order; each returns false after recording a fault.
+  bool windowStage(const TickInput& input);
+  bool inputStage(const TickInput& input);
+  bool windStage();
+  bool collisionStage();
+  bool integrateStage();
+  bool patchStage();
+  /// Records a fixed-point fault of `stage` as the world's failure; returns false.
+  bool failWith(Stage stage, uint32_t faults);
   template <class Fn>
   bool runParticleRows(Stage stage, Fn&& rowKernel);
   void applyCommands(const TickInput& input);
@@ -211,9 +140,6 @@ class World final : public SimWorld {
     InputVec3 position;
   };
   std::vector<Spawned> spawns_;
-  /// Parses the body-input block of a saved state at `at` (restoreState); throws StateError.
-  void readBodyInputBlock(std::span<const uint8_t> bytes, size_t at, size_t bodyCount, std::vector<Spawned>* spawns,
-                          std::vector<uint8_t>* bladeOff) const;
   /// Mown patches by lattice coordinates (i, j): persistent, ordered, saved and hashed.
   std::map<std::pair<int64_t, int64_t>, uint8_t> cuts_;
   S mowerCutHeight_{};

@@ -5,11 +5,16 @@
 #include <fstream>
 #include <sstream>
 
+#include "replay/kernel_environment.h"
 #include "viewer/app/app.h"
 
 int main(int argc, char** argv) {
   using namespace sg;
   using namespace sg::viewer;
+  if (!applyKernelEnvironment()) {
+    std::fprintf(stderr, "simgrass-viewer: SIMGRASS_KERNEL: expected scalar, avx2 or auto\n");
+    return kExitBadInput;
+  }
   Options o;
   if (const int code = parseOptions(argc, argv, &o); code >= 0) return code;
   std::vector<ScriptCommand> script;

@@ -1,0 +1,105 @@
+// Body commands of World<S>: the recorded inputs that push, teleport, reset, spawn bodies and
+// switch mower blades (tick_input.h), applied at the start of a tick in their recorded order.
+#include <algorithm>
+
+#include "sim/bodies/integrate_bodies.h"
+#include "sim/world/input_conversion.h"
+#include "sim/world/world.h"
+
+namespace sg {
+
+template <class S>
+void World<S>::applyCommands(const TickInput& input) {
+  for (const BodyCommand& cmd : input.bodies) {
+    if (cmd.body < 0 || size_t(cmd.body) >= bodies_.size()) continue;  // validated by the reader
+    if (cmd.kind == BodyCommandKind::Spawn) {
+      spawnBody(cmd.body, cmd.value);
+      continue;
+    }
+    RigidBody<S>& b = bodies_[size_t(cmd.body)];
+    // The blade switches touch only a mower's blade (not its sleep): anything else ignores them.
+    if (cmd.kind == BodyCommandKind::MowerOn || cmd.kind == BodyCommandKind::MowerOff) {
+      if (b.mower) b.bladeOn = cmd.kind == BodyCommandKind::MowerOn;
+      continue;
+    }
+    wake(b);
+    const Vec3<S> v = inputVector<S>(cmd.value);
+    switch (cmd.kind) {
+      case BodyCommandKind::Displace: b.position += v; break;
+      case BodyCommandKind::AddVelocity: b.velocity += v; break;
+      case BodyCommandKind::Impulse: b.velocity += v * b.invMass; break;
+      case BodyCommandKind::Teleport:
+        b.position = v;
+        b.velocity = Vec3<S>::Zero();
+        b.angularVelocity = Vec3<S>::Zero();
+        break;
+      case BodyCommandKind::Reset: resetBody(size_t(cmd.body)); break;
+      case BodyCommandKind::Spawn:
+      case BodyCommandKind::MowerOn:
+      case BodyCommandKind::MowerOff: break;  // handled above
+    }
+  }
+}
+
+template <class S>
+void World<S>::resetBody(size_t body) {
+  // The start pose: the scenario's for a scenario body, the spawn position and the template's
+  // orientation for a spawned one; at rest and awake either way (the scenario's initial
+  // velocity is not given again), its blade left as it is.
+  const size_t scenarioBodies = initialBodies_.size();
+  const RigidBody<S>& start = initialBodies_[size_t(bodyTemplate(int64_t(body)))];
+  RigidBody<S>& b = bodies_[body];
+  b.position = body < scenarioBodies ? start.position : inputVector<S>(spawns_[body - scenarioBodies].position);
+  b.orientation = start.orientation;
+  b.velocity = Vec3<S>::Zero();
+  b.angularVelocity = Vec3<S>::Zero();
+  b.stillTicks = 0;
+  b.asleep = false;
+  b.updateDerived();
+  dropCachedImpulses(body);
+}
+
+template <class S>
+void World<S>::spawnBody(int32_t templateBody, const InputVec3& at) {
+  // Beyond the cap the command is ignored (every replay ignores it the same way).
+  if (bodies_.size() >= size_t(kMaxBodies)) return;
+  Spawned spawned{bodyTemplate(templateBody), at};  // a spawned template stands for its own template
+  RigidBody<S> b = initialBodies_[size_t(spawned.templateBody)];
+  b.position = inputVector<S>(at);
+  b.velocity = Vec3<S>::Zero();
+  b.angularVelocity = Vec3<S>::Zero();
+  b.updateDerived();
+  bodies_.push_back(b);
+  spawns_.push_back(spawned);
+}
+
+template <class S>
+void World<S>::dropCachedImpulses(size_t body) {
+  const int32_t id = int32_t(body);
+  std::erase_if(impulseCache_, [id](const CachedImpulse<S>& c) { return c.bodyA == id || c.bodyB == id; });
+}
+
+template <class S>
+int32_t World<S>::bodyTemplate(int64_t body) const {
+  const int64_t scenarioBodies = int64_t(initialBodies_.size());
+  if (body < 0 || body >= int64_t(bodies_.size())) return -1;
+  return body < scenarioBodies ? int32_t(body) : spawns_[size_t(body - scenarioBodies)].templateBody;
+}
+
+template <class S>
+bool World<S>::bladeOn(int64_t body) const {
+  return body >= 0 && body < int64_t(bodies_.size()) && bodies_[size_t(body)].mower && bodies_[size_t(body)].bladeOn;
+}
+
+
+#define SG_INSTANTIATE_COMMANDS(S) \
+  template void World<S>::applyCommands(const TickInput&); \
+  template void World<S>::resetBody(size_t); \
+  template void World<S>::spawnBody(int32_t, const InputVec3&); \
+  template void World<S>::dropCachedImpulses(size_t); \
+  template int32_t World<S>::bodyTemplate(int64_t) const; \
+  template bool World<S>::bladeOn(int64_t) const; \
+
+SG_FOR_EACH_SCALAR(SG_INSTANTIATE_COMMANDS)
+
+}  // namespace sg

@@ -1,0 +1,28 @@
+// Which implementation runs the hot loops of the step. Part of the public API (a tool may pin the
+// reference); the kernels themselves live in particle_row.h and patches/patch_row_avx2.cpp.
+#pragma once
+
+#include <cstdint>
+
+namespace sg {
+
+/// Which implementation of the hot loops a world runs: the fused particle pass
+/// (particles/particle_row.h) and the patch stage's loops (patches/patch_row_avx2.cpp). Both give
+/// bit-identical state and the same fault reports; Avx2 applies to the fixed-point scalars on CPUs
+/// that have it.
+enum class ParticleKernel : uint8_t { Scalar = 0, Avx2 = 1 };
+
+/// "scalar" or "avx2".
+const char* particleKernelName(ParticleKernel kernel);
+/// Whether this CPU runs the AVX2 kernel.
+bool avx2KernelAvailable();
+/// The kernel a new world uses: AVX2 where the CPU has it, unless setDefaultParticleKernel chose
+/// the reference. The core reads no environment: tools map SIMGRASS_KERNEL onto this
+/// (replay/kernel_environment.h).
+ParticleKernel defaultParticleKernel();
+/// Sets what defaultParticleKernel() returns for worlds built afterwards (a process-wide choice,
+/// read only when a world is built, never inside the step). Avx2 where the CPU lacks it means
+/// Scalar.
+void setDefaultParticleKernel(ParticleKernel kernel);
+
+}  // namespace sg

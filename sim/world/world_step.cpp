@@ -1,0 +1,161 @@
+// The step of World<S>: one fixed tick as a sequence of stages in the thesis order (runPhysics,
+// thesis section 9.2). Each stage is timed through the observer (begin and end always paired) and
+// a fault is attributed to the stage that raised it.
+#include "sim/bodies/integrate_bodies.h"
+#include "sim/world/settings.h"
+#include "sim/world/world.h"
+#include "sim/world/world_rows.h"
+
+namespace sg {
+
+template <class S>
+void World<S>::updatePatchState() {
+  const S rod = particleConsts_.rodLength;
+  pool_->run((grid_.countZ + rowsPerChunk_ - 1) / rowsPerChunk_, [&](int64_t c, int) {
+    const int64_t b1 = std::min(grid_.countZ, (c + 1) * rowsPerChunk_);
+    particleDisplacement(particles_, c * rowsPerChunk_ * grid_.countX, b1 * grid_.countX, rod, dispX_, dispY_, dispZ_);
+  });
+  updatePatchesFromDisplacement();
+}
+
+template <class S>
+void World<S>::updatePatchesFromDisplacement() {
+  if (grid_.k == 1) {  // patch and particle windows coincide: storage index for storage index
+    const PatchWriter<S> out(patches_, patchConsts_);
+    const S *dx = dispX_.data(), *dy = dispY_.data(), *dz = dispZ_.data();
+    pool_->run((grid_.countZ + rowsPerChunk_ - 1) / rowsPerChunk_, [&](int64_t c, int) {
+      const int64_t q0 = c * rowsPerChunk_ * grid_.countX;
+      const int64_t q1 = std::min(grid_.countZ, (c + 1) * rowsPerChunk_) * grid_.countX;
+      if constexpr (ScalarTraits<S>::isFixed)
+        if (particleKernel_ == ParticleKernel::Avx2)
+          return writePatchesAvx2(out, size_t(q0), dx + q0, dy + q0, dz + q0, q1 - q0);
+      for (int64_t q = q0; q < q1; ++q)
+        out.writeFast(size_t(q), dx[q], dy[q], dz[q]);  // same bits as write(): patch_state.h
+    });
+    return;
+  }
+  const bool vector = particleKernel_ == ParticleKernel::Avx2;
+  const LatticeWindow& pw = patchWindow_;
+  const int64_t patchRowsPerChunk = std::max<int64_t>(1, settings::kTargetChunkElements / pw.sizeI);
+  pool_->run((pw.sizeJ + patchRowsPerChunk - 1) / patchRowsPerChunk, [&](int64_t c, int worker) {
+    S* scratch = rowScratch_.data() + size_t(worker) * size_t(3 * (grid_.countX + pw.sizeI));
+    const int64_t j1 = pw.originJ + std::min(pw.sizeJ, (c + 1) * patchRowsPerChunk);
+    for (int64_t j = pw.originJ + c * patchRowsPerChunk; j < j1; ++j)
+      exactRowWeights_ && grid_.k == 2 ? updatePatchRow<S, 2>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch, vector)
+      : exactRowWeights_ && grid_.k == 4 ? updatePatchRow<S, 4>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch, vector)
+                                          : updatePatchRow<S>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch);
+  });
+}
+
+
+template <class S>
+StepResult World<S>::step(const TickInput& input, StageObserver* observer) {
+  if (failed_) return {false, failure_};
+  takeFixedFaults();  // faults raised outside the step (tools, tests) are not this tick's
+  // One stage: timed through the observer (begin and end always paired); a stage that fails has
+  // recorded its fault in failure_ and the tick stops there.
+  auto stage = [&](Stage st, auto&& run) {
+    if (observer) observer->stageBegin(st);
+    const bool ok = run();
+    if (observer) observer->stageEnd(st);
+    return ok;
+  };
+  // A scenario without bodies pays nothing for the body stages, one without the level of detail
+  // nothing for the window.
+  const bool bodies = !bodies_.empty();
+  const bool ok = (!lodWindow_ || stage(Stage::Window, [&] { return windowStage(input); })) &&
+                  (!bodies || stage(Stage::Input, [&] { return inputStage(input); })) &&
+                  stage(Stage::Wind, [&] { return windStage(); }) &&
+                  (!bodies || stage(Stage::Collision, [&] { return collisionStage(); })) &&
+                  (!bodies || stage(Stage::Response, [&] { return respondToContacts(); })) &&
+                  stage(Stage::Integrate, [&] { return integrateStage(); }) &&
+                  stage(Stage::PatchState, [&] { return patchStage(); });
+  if (!ok) return {false, failure_};
+  ++tick_;
+  return {};
+}
+
+template <class S>
+bool World<S>::failWith(Stage stage, uint32_t faults) {
+  failed_ = true;
+  failure_ = SimError{};
+  failure_.tick = tick_;
+  failure_.stage = stage;
+  failure_.what = fixedFaultName(faults);
+  return false;
+}
+
+template <class S>
+bool World<S>::windowStage(const TickInput& input) {
+  if (input.hasCamera) followCamera(input.camera);
+  // Entering cells are filled in parallel from the lattice and the terrain, whose values the
+  // scenario validation keeps in range; fault bits would be seen only on this thread, so reading
+  // them would make the result depend on the thread count. Cleared, never reported.
+  takeFixedFaults();
+  return true;
+}
+
+template <class S>
+bool World<S>::inputStage(const TickInput& input) {
+  applyCommands(input);
+  return !bodiesFaulted(Stage::Input);
+}
+
+template <class S>
+bool World<S>::windStage() {
+  computeRowAcceleration(windSchedule_, windConsts_, tick_, &rowAccel_);
+  const uint32_t faults = takeFixedFaults();
+  return faults == 0 || failWith(Stage::Wind, faults);
+}
+
+template <class S>
+bool World<S>::collisionStage() {
+  detectContacts();
+  return !bodiesFaulted(Stage::Collision);
+}
+
+template <class S>
+bool World<S>::integrateStage() {
+  const ParticleConstants<S>& c = particleConsts_;
+  const bool pbd = constraintMode_ == ConstraintMode::Pbd;
+  // Integration, the rod constraint and the tip displacement run as one pass, row by row
+  // (sim/particles/particle_row.h): bit-identical to three passes, a third of the memory traffic.
+  // Its time is reported under Stage::Integrate; Stage::Constraints names a projection fault.
+  const bool moved = runParticleRows(Stage::Integrate, [&](int64_t row, int64_t b, int64_t e) {
+    const size_t windRow = size_t(grid_.window.latticeRow(row));  // the wind acts per lattice row
+    const S dvx = rowAccel_.x[windRow], dvy = rowAccel_.y[windRow], dvz = rowAccel_.z[windRow];
+    const ParticleKernel kernel = particleKernel_;
+    return pbd ? advanceParticleRow<S, true>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_)
+               : advanceParticleRow<S, false>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_);
+  });
+  if (!moved || bodies_.empty()) return moved;
+  integrateBodyPositions(bodies_, c.dt);
+  updateSleep(bodies_, sleepLinear_, sleepAngular_, ticksToSleep_);
+  return !bodiesFaulted(Stage::Integrate);
+}
+
+template <class S>
+bool World<S>::patchStage() {
+  // The patch stage is derived data only (never fed back into the state) and runs unchecked
+  // arithmetic with Fixed's exact bits (patches/patch_state.h); like the window, its bits are
+  // cleared so they cannot be blamed on a later stage.
+  updatePatchesFromDisplacement();
+  takeFixedFaults();
+  return true;
+}
+
+#define SG_INSTANTIATE_STEP(S) \
+  template StepResult World<S>::step(const TickInput&, StageObserver*); \
+  template void World<S>::updatePatchState(); \
+  template void World<S>::updatePatchesFromDisplacement(); \
+  template bool World<S>::failWith(Stage, uint32_t); \
+  template bool World<S>::windowStage(const TickInput&); \
+  template bool World<S>::inputStage(const TickInput&); \
+  template bool World<S>::windStage(); \
+  template bool World<S>::collisionStage(); \
+  template bool World<S>::integrateStage(); \
+  template bool World<S>::patchStage(); \
+
+SG_FOR_EACH_SCALAR(SG_INSTANTIATE_STEP)
+
+}  // namespace sg
