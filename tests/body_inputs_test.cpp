@@ -406,7 +406,9 @@ TEST(BodyInputs, DamagedBodyInputsGiveAStateErrorNeverACrash) {
       auto probe = makeTyped<Fx32>(s);
       probe->restoreState(bad);
       const StepResult r = probe->step(TickInput{});
-      if (!r.ok) EXPECT_NE(r.error.message().find("simulation error at tick"), std::string::npos);
+      if (!r.ok) {
+        EXPECT_NE(r.error.message().find("simulation error at tick"), std::string::npos);
+      }
     } catch (const StateError&) {
     }
   }

@@ -17,6 +17,7 @@ struct GoldenCase {
   std::string scenario;
   std::string scalar;
 };
+void PrintTo(const GoldenCase& c, std::ostream* os) { *os << c.scenario << " " << c.scalar; }
 
 nlohmann::json goldens() {
   std::ifstream in(test::sourcePath("tests/golden/state_hashes.json"));

@@ -15,6 +15,7 @@
 
 #include "sim/math/eigen_support.h"
 #include "sim/math/fixed.h"
+#include "tests/printers.h"
 
 namespace {
 

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "sim/math/fixed.h"
+#include "tests/printers.h"
 
 namespace {
 

@@ -548,6 +548,9 @@ struct WorldCase {
   int k;
   bool pbd;
 };
+void PrintTo(const WorldCase& c, std::ostream* os) {
+  *os << c.scenario << " " << c.scalar << " k=" << c.k << (c.pbd ? " pbd" : " thesis");
+}
 
 class KernelWorlds : public ::testing::TestWithParam<WorldCase> {};
 

@@ -15,6 +15,7 @@
 
 #include "sim/math/rational.h"
 #include "sim/math/scalar.h"
+#include "tests/printers.h"
 
 namespace {
 

@@ -50,6 +50,7 @@ struct ScenarioCase {
   const char* file;
   int64_t ticks;  ///< Release build; the sanitizer build runs fewer
 };
+void PrintTo(const ScenarioCase& c, std::ostream* os) { *os << c.file << ", " << c.ticks << " ticks"; }
 
 class RecordReplay : public testing::TestWithParam<std::tuple<ScenarioCase, ScalarKind>> {};
 

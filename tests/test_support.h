@@ -9,6 +9,7 @@
 #include "replay/scenario_files.h"
 #include "sim/scenario/scenario.h"
 #include "sim/world/world.h"
+#include "tests/printers.h"
 
 namespace sg::test {
 

@@ -76,7 +76,17 @@ class RawNumberCollector : public nlohmann::json_sax<json> {
   std::vector<Frame> frames_;
   std::string path() const {
     std::string p = "$";
-    for (const Frame& f : frames_) p += f.array ? "[" + std::to_string(f.index) + "]" : "." + f.key;
+    // Appended piece by piece: `"[" + std::string&&` trips GCC 12's -Wrestrict false positive (PR105329).
+    for (const Frame& f : frames_) {
+      if (f.array) {
+        p += '[';
+        p += std::to_string(f.index);
+        p += ']';
+      } else {
+        p += '.';
+        p += f.key;
+      }
+    }
     return p;
   }
   bool after() {
