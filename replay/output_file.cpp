@@ -15,7 +15,11 @@ namespace sg {
 bool writeFileAtomic(const std::string& path, std::span<const uint8_t> bytes, std::string* error) {
   const std::filesystem::path target(path);
   const std::filesystem::path folder = target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
-  std::string pattern = (folder / ("." + target.filename().string() + ".tmp-XXXXXX")).string();
+  // Built by appends: `"." + std::string&&` trips GCC 12's -Wrestrict false positive (PR105329).
+  std::string leaf = ".";
+  leaf += target.filename().string();
+  leaf += ".tmp-XXXXXX";
+  const std::string pattern = (folder / leaf).string();
   std::vector<char> name(pattern.begin(), pattern.end());
   name.push_back('\0');
   const int fd = mkstemp(name.data());

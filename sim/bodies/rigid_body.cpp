@@ -31,7 +31,7 @@ struct Exact {
 Rational volumeOf(const ShapeSpec& p, const Exact& x) {
   if (p.type == ShapeType::Sphere) {
     const Rational r3 = x.mul(x.mul(p.radius, p.radius), p.radius);
-    return x.mul(r3, Rational{4 * 355, 3 * 113});
+    return x.mul(r3, Rational{1420, 339}  /* 4/3 pi with pi = 355/113 */);
   }
   return x.mul(x.mul(x.mul(p.halfExtents[0], p.halfExtents[1]), p.halfExtents[2]), Rational{8, 1});
 }

@@ -251,14 +251,17 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
     S* bx = scratch;
     S* by = scratch + nx;
     S* bz = scratch + 2 * nx;
-    if (kFast && vector) {
-      if constexpr (kFast) {
+    bool blended = false;
+    if constexpr (kFast) {
+      if (vector) {
         const int quarters = K == 2 ? 2 : t;  // the weight t / K in quarters
         blendRowsAvx2(rx, sx, bx, nx, quarters);
         blendRowsAvx2(ry, sy, by, nx, quarters);
         blendRowsAvx2(rz, sz, bz, nx, quarters);
+        blended = true;
       }
-    } else {
+    }
+    if (!blended) {
       for (int64_t a = 0; a < nx; ++a) {
         bx[a] = blend(rx[a], sx[a], t);
         by[a] = blend(ry[a], sy[a], t);

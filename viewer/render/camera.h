@@ -17,8 +17,8 @@ inline Mat4 multiply(const Mat4& a, const Mat4& b) {
   for (int c = 0; c < 4; ++c)
     for (int row = 0; row < 4; ++row) {
       float s = 0;
-      for (int k = 0; k < 4; ++k) s += a[size_t(k * 4 + row)] * b[size_t(c * 4 + k)];
-      r[size_t(c * 4 + row)] = s;
+      for (int k = 0; k < 4; ++k) s += a[size_t(k) * 4 + size_t(row)] * b[size_t(c) * 4 + size_t(k)];
+      r[size_t(c) * 4 + size_t(row)] = s;
     }
   return r;
 }
