@@ -6,7 +6,7 @@
 #include "replay/cli/compare_command.h"
 #include "replay/cli/diff_command.h"
 #include "replay/cli/record_command.h"
-#include "replay/cli/render_command.h"
+#include "replay/cli/render_hook.h"
 #include "replay/cli/replay_command.h"
 #include "replay/cli/run_command.h"
 #include "replay/cli/sweep_command.h"
@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
   sg::addDiffCommand(app, &exitCode);
   sg::addCompareCommand(app, &exitCode);
   sg::addSweepCommand(app, &exitCode);
-  sg::addRenderCommand(app, &exitCode);
+  sg::addRenderCommand(app, &exitCode);  // the viewer's, or a stub in a build without it
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,4 +1,8 @@
-#include "replay/cli/render_command.h"
+// `simgrass render`: run a scenario (or replay a `.sgr` recording) and write PNG frames of chosen
+// ticks, rendered offscreen (OSMesa); optionally a contact sheet and a video (docs/rendering.md).
+// Lives on the viewer side of the layers (it draws with viewer/); the `simgrass` executable links
+// it when the viewer is built, through the hook declared in replay/cli/render_hook.h.
+#include "replay/cli/render_hook.h"
 
 #include <unistd.h>
 
