@@ -32,8 +32,10 @@ S toS(const Rational& r) {
 }
 
 void hashRational(HashSink& h, const Rational& r) {
-  h.write(&r.num, sizeof r.num);
-  h.write(&r.den, sizeof r.den);
+  // Two's complement limbs, low first: the bytes a builtin __int128 has in memory on the
+  // little-endian hosts this serialisation supports, whichever Int128 type the build uses.
+  const uint64_t limbs[4] = {low64(r.num), high64(r.num), low64(r.den), high64(r.den)};
+  h.write(limbs, sizeof limbs);
 }
 
 /// Fingerprint of everything that shapes the world (not the name or description), so a saved
