@@ -169,12 +169,15 @@ TEST(RationalParse, DecimalsAreExactNotBinary) {
 // ---- toDouble -------------------------------------------------------------------------------
 
 TEST(RationalToDouble, MatchesStrtod) {
+  // glibc's strtod is correctly rounded (nearest, ties to even) for any decimal, and so is
+  // toDouble for any num/den: they must agree exactly, small operands or not.
   std::mt19937_64 g(0x7a7a);
-  int parsed = 0, exactChecked = 0, ulpChecked = 0;
+  int parsed = 0, smallChecked = 0, largeChecked = 0;
   const int kN = 100000;
   for (int i = 0; i < kN; ++i) {
-    // A random decimal: 1..17 significant digits, an optional point, an optional exponent.
-    const int digits = 1 + int(g() % 17);
+    // A random decimal: 1..30 significant digits (the parser's limit), an optional point, an
+    // optional exponent.
+    const int digits = 1 + int(g() % (g() % 4 == 0 ? 30 : 17));
     std::string s = (g() & 1) ? "-" : "";
     std::string mant;
     for (int k = 0; k < digits; ++k) mant += char('0' + int(g() % 10));
@@ -192,23 +195,111 @@ TEST(RationalToDouble, MatchesStrtod) {
     errno = 0;
     const double want = std::strtod(s.c_str(), nullptr);
     constexpr I128 k2p53 = I128(1) << 53;
-    if (r->num > -k2p53 && r->num < k2p53 && r->den < k2p53) {
-      // Both operands exact in double: one IEEE division, correctly rounded (documented).
-      ++exactChecked;
-      ASSERT_EQ(got, want) << s << " = " << str(*r);
-    } else {
-      // Documented: within 1 ulp when num or den exceeds 2^53 (long double path).
-      ++ulpChecked;
-      ASSERT_TRUE(got == want || got == std::nextafter(want, 0.0) || got == std::nextafter(want, 2 * want))
-          << s << " = " << str(*r) << ": got " << got << " want " << want;
-    }
+    // Both operands below 2^53 (one IEEE division would round the same) or not.
+    ++(r->num > -k2p53 && r->num < k2p53 && r->den < k2p53 ? smallChecked : largeChecked);
+    ASSERT_EQ(got, want) << s << " = " << str(*r) << ": got " << got << " want " << want;
   }
   EXPECT_GT(parsed, kN * 9 / 10);
-  EXPECT_GT(exactChecked, kN / 4);
-  EXPECT_GT(ulpChecked, kN / 10);
+  EXPECT_GT(smallChecked, kN / 4);
+  EXPECT_GT(largeChecked, kN / 10);
   EXPECT_EQ(parse("0.1")->toDouble(), 0.1);
   EXPECT_EQ(parse("1/3")->toDouble(), 1.0 / 3.0);
   EXPECT_EQ(parse("-0.97")->toDouble(), -0.97);
+}
+
+/// Unsigned big integers as 32-bit digits (little-endian), just enough for exact comparisons of
+/// products of 128-bit values scaled by powers of two: independent of the code under test.
+using Big = std::vector<uint32_t>;
+Big big(U128 v) {
+  Big r;
+  for (; v != 0; v >>= 32) r.push_back(uint32_t(v));
+  return r;
+}
+Big mulBig(const Big& a, const Big& b) {
+  Big r(a.size() + b.size(), 0);
+  for (size_t i = 0; i < a.size(); ++i) {
+    uint64_t carry = 0;
+    for (size_t j = 0; j < b.size(); ++j) {
+      const uint64_t t = uint64_t(a[i]) * b[j] + r[i + j] + carry;
+      r[i + j] = uint32_t(t);
+      carry = t >> 32;
+    }
+    r[i + b.size()] = uint32_t(carry);
+  }
+  return r;
+}
+Big shlBig(const Big& a, int n) {
+  Big r(size_t(n / 32), 0);
+  uint32_t carry = 0;
+  for (uint32_t d : a) {
+    r.push_back(n % 32 == 0 ? d : (d << (n % 32)) | carry);
+    carry = n % 32 == 0 ? 0 : d >> (32 - n % 32);
+  }
+  r.push_back(carry);
+  return r;
+}
+int cmpBig(Big a, Big b) {
+  while (!a.empty() && a.back() == 0) a.pop_back();
+  while (!b.empty() && b.back() == 0) b.pop_back();
+  if (a.size() != b.size()) return a.size() < b.size() ? -1 : 1;
+  for (size_t i = a.size(); i-- > 0;)
+    if (a[i] != b[i]) return a[i] < b[i] ? -1 : 1;
+  return 0;
+}
+/// Sign of n/d - m * 2^e for n, d, m > 0.
+int cmpWithScaled(U128 n, U128 d, U128 m, int e) {
+  return cmpBig(shlBig(big(n), e < 0 ? -e : 0), shlBig(mulBig(big(m), big(d)), e > 0 ? e : 0));
+}
+
+/// Checks that c is the double nearest to |num|/den, ties to even, from the exact midpoints to
+/// c's neighbours (c = M * 2^E with a 53-bit M; below a power of two the lower neighbour is
+/// half as far).
+::testing::AssertionResult correctlyRounded(const Rational& r, double c) {
+  const U128 n = r.num < 0 ? U128(0) - U128(r.num) : U128(r.num), d = U128(r.den);
+  if ((c < 0) != (r.num < 0) || c == 0) return ::testing::AssertionFailure() << "sign or zero";
+  int ex = 0;
+  const double f = std::frexp(std::fabs(c), &ex);  // exact
+  const uint64_t m = uint64_t(std::ldexp(f, 53));    // exact: 2^52 <= m < 2^53
+  const int e = ex - 53;
+  const int above = cmpWithScaled(n, d, 2 * U128(m) + 1, e - 1);
+  const int below = m == (uint64_t(1) << 52) ? cmpWithScaled(n, d, 4 * U128(m) - 1, e - 2)
+                                              : cmpWithScaled(n, d, 2 * U128(m) - 1, e - 1);
+  if (above > 0 || below < 0) return ::testing::AssertionFailure() << "not the nearest double";
+  if ((above == 0 || below == 0) && (m & 1) != 0) return ::testing::AssertionFailure() << "tie not to even";
+  return ::testing::AssertionSuccess();
+}
+
+TEST(RationalToDouble, CorrectlyRoundedForAnySize) {
+  // num and den of every bit length up to 127, so the quotient spans 2^-127 .. 2^127 and the
+  // long division produces anywhere from 54 to 127 quotient bits.
+  std::mt19937_64 g(0xd0b1e);
+  auto draw = [&g]() -> I128 {
+    const int bits = 1 + int(g() % 127);
+    const U128 v = ((U128(g()) << 64 | g()) >> (128 - bits)) | (U128(1) << (bits - 1));
+    return I128(v);
+  };
+  for (int i = 0; i < 50000; ++i) {
+    const I128 num = g() & 1 ? -draw() : draw();
+    const auto r = Rational::make(num, draw());
+    ASSERT_TRUE(r.has_value());
+    ASSERT_TRUE(correctlyRounded(*r, r->toDouble())) << str(*r) << " -> " << r->toDouble();
+  }
+}
+
+TEST(RationalToDouble, TiesGoToEvenAndTheStickyBitCounts) {
+  const I128 k2p53 = I128(1) << 53;
+  EXPECT_EQ((Rational{k2p53 + 1, 1}).toDouble(), 9007199254740992.0);      // 2^53 + 1, a tie: down to even
+  EXPECT_EQ((Rational{k2p53 + 3, 1}).toDouble(), 9007199254740996.0);      // 2^53 + 3, a tie: up to even
+  EXPECT_EQ((Rational{4 * k2p53 + 5, 4}).toDouble(), 9007199254740994.0);  // 2^53 + 1.25: above the tie (sticky)
+  EXPECT_EQ((Rational{4 * k2p53 + 3, 4}).toDouble(), 9007199254740992.0);  // 2^53 + 0.75
+  EXPECT_EQ((Rational{2 * k2p53 + 3, 2}).toDouble(), 9007199254740994.0);  // 2^53 + 1.5
+  // Huge numerators and denominators: no long double on the way.
+  EXPECT_EQ((Rational{sg::kInt128Max, 1}).toDouble(), std::ldexp(1.0, 127));
+  EXPECT_EQ((Rational{sg::kInt128Min + 1, 1}).toDouble(), -std::ldexp(1.0, 127));
+  EXPECT_EQ((Rational{1, sg::kInt128Max}).toDouble(), std::ldexp(1.0, -127));
+  EXPECT_EQ((Rational{1, I128(1) << 126}).toDouble(), std::ldexp(1.0, -126));
+  EXPECT_EQ((Rational{1, 3 * (I128(1) << 100)}).toDouble(), std::ldexp(1.0 / 3.0, -100));
+  EXPECT_EQ((Rational{(I128(1) << 120) + 1, 1}).toDouble(), std::ldexp(1.0, 120));
 }
 
 // ---- toScaledInteger / roundToInt64 ----------------------------------------------------------------
@@ -319,6 +410,30 @@ TEST(RationalArithmetic, MatchesCrossMultiplication) {
     const I128 l = a.num * b.den, r = b.num * a.den;
     ASSERT_EQ(sg::compare(a, b), l < r ? -1 : (l > r ? 1 : 0)) << str(a) << " <=> " << str(b);
     ASSERT_EQ(sg::compare(b, a), -sg::compare(a, b));
+  }
+}
+
+TEST(RationalArithmetic, CompareIsExactForAnySize) {
+  // Operands whose cross products need up to 254 bits (the old code fell back to long double
+  // there): against exact big-integer cross products.
+  std::mt19937_64 g(0xc0c0);
+  auto draw = [&g](bool positive) -> I128 {
+    const int bits = 1 + int(g() % 127);
+    const I128 v = I128(((U128(g()) << 64 | g()) >> (128 - bits)) | (U128(1) << (bits - 1)));
+    return positive || (g() & 1) ? v : -v;
+  };
+  auto mag = [](I128 v) { return v < 0 ? U128(0) - U128(v) : U128(v); };
+  for (int i = 0; i < 50000; ++i) {
+    const auto a = Rational::make(draw(false), draw(true));
+    // Every fourth pair shares a's value up to a tiny step, so near-equal values are compared.
+    auto b = Rational::make(draw(false), draw(true));
+    if (i % 4 == 0) b = sg::add(*a, g() % 3 == 0 ? Rational{0, 1} : Rational{1, I128(1) << 120});
+    if (!b) continue;
+    const int sa = a->num < 0 ? -1 : 1, sb = b->num < 0 ? -1 : (b->num > 0 ? 1 : 0);
+    int want = sa != sb ? (sa < sb ? -1 : 1)
+                        : sa * cmpBig(mulBig(big(mag(a->num)), big(U128(b->den))), mulBig(big(mag(b->num)), big(U128(a->den))));
+    ASSERT_EQ(sg::compare(*a, *b), want) << str(*a) << " <=> " << str(*b);
+    ASSERT_EQ(sg::compare(*b, *a), -want);
   }
 }
 

@@ -15,8 +15,10 @@ const char* fixedFaultName(uint32_t faults) noexcept {
   return "none";
 }
 
-uint64_t isqrtFloor(unsigned __int128 n) noexcept {
-  using U = unsigned __int128;
+namespace {
+/// One algorithm for both unsigned 128-bit types (builtin and portable): same integer steps.
+template <class U>
+uint64_t isqrtFloorImpl(U n) noexcept {
   if (n == 0) return 0;
   // A double estimate, then exact integer correction: only the corrected integer is kept, so
   // the result is exact and identical on every machine whatever the estimate's rounding.
@@ -37,4 +39,10 @@ uint64_t isqrtFloor(unsigned __int128 n) noexcept {
   while (r != ~uint64_t(0) && (U(r) + 1) * (U(r) + 1) <= n) ++r;
   return r;
 }
+}  // namespace
+
+uint64_t isqrtFloor(UInt128 n) noexcept { return isqrtFloorImpl(n); }
+#if SIMGRASS_NATIVE_INT128
+uint64_t isqrtFloor(portable::UInt128 n) noexcept { return isqrtFloorImpl(n); }
+#endif
 }  // namespace sg

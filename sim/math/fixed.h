@@ -1,7 +1,10 @@
 // Fixed-point scalars for the deterministic core.
 //
-//   Fx32 = Q32.32 in int64_t, products and quotients in __int128 (the reference scalar).
+//   Fx32 = Q32.32 in int64_t, products and quotients in Int128   (the reference scalar).
 //   Fx16 = Q16.16 in int32_t, products and quotients in int64_t  (the fast variant).
+// Int128 (sim/math/int128.h) is the builtin __int128 where the compiler has it, else a portable
+// two-limb struct with the same bits: the wide type is a template parameter, so tests build
+// Fixed<int64_t, portable::Int128, 32> next to Fx32 and compare them bit for bit.
 //
 // Rounding (documented in docs/fixed-point.md, tested against exact references):
 //   * a * b, a / b and sqrt(a) round to nearest; exact ties round away from zero. This makes
@@ -17,6 +20,8 @@
 #include <cstdint>
 #include <limits>
 #include <type_traits>
+
+#include "sim/math/int128.h"
 
 namespace sg {
 
@@ -47,12 +52,23 @@ const char* fixedFaultName(uint32_t faults) noexcept;
 
 /// Integer square roots, exact: floor variant and round-to-nearest variant. isqrtNearest needs
 /// n <= 2^128 - 2^64 (its result must fit 64 bits); sqrt and length3 stay far below that.
-uint64_t isqrtFloor(unsigned __int128 n) noexcept;
-inline uint64_t isqrtNearest(unsigned __int128 n) noexcept {
+/// Overloaded for the portable type too where UInt128 is the builtin one (tests compare them).
+uint64_t isqrtFloor(UInt128 n) noexcept;
+#if SIMGRASS_NATIVE_INT128
+uint64_t isqrtFloor(portable::UInt128 n) noexcept;
+#endif
+namespace detail {
+template <class U>
+inline uint64_t isqrtNearest(U n) noexcept {
   const uint64_t r = isqrtFloor(n);
   // (r + 1/2)^2 = r^2 + r + 1/4, so n rounds up exactly when n - r^2 > r (no ties for integers).
-  return (n - static_cast<unsigned __int128>(r) * r > r) ? r + 1 : r;
+  return (n - static_cast<U>(r) * r > r) ? r + 1 : r;
 }
+}  // namespace detail
+inline uint64_t isqrtNearest(UInt128 n) noexcept { return detail::isqrtNearest(n); }
+#if SIMGRASS_NATIVE_INT128
+inline uint64_t isqrtNearest(portable::UInt128 n) noexcept { return detail::isqrtNearest(n); }
+#endif
 
 template <class Raw, class Wide, int Frac>
 class Fixed {
@@ -62,6 +78,7 @@ class Fixed {
  public:
   using RawType = Raw;
   using WideType = Wide;
+  using UnsignedWideType = UnsignedOfT<Wide>;
   static constexpr int kFracBits = Frac;
   static constexpr Raw kOneRaw = Raw(1) << Frac;
 
@@ -131,21 +148,31 @@ class Fixed {
 
   template <class I>
   static constexpr Raw fromInteger(I value) noexcept {
-    // Compared in 128 bits, so every integer type up to __int128 is handled exactly.
-    constexpr __int128 kMaxInt = std::numeric_limits<Raw>::max() >> Frac;
-    constexpr __int128 kMinInt = std::numeric_limits<Raw>::min() >> Frac;
+    // The limits are compared in the wider of I and Raw, where both convert exactly (kMaxInt >= 0
+    // also converts exactly to an unsigned I), so every integer type, __int128 included, is
+    // handled exactly without a 128-bit type of our own.
+    constexpr Raw kMaxInt = std::numeric_limits<Raw>::max() >> Frac;
+    constexpr Raw kMinInt = std::numeric_limits<Raw>::min() >> Frac;
     bool above, below = false;
     if constexpr (std::is_signed_v<I>) {
-      above = __int128(value) > kMaxInt;
-      below = __int128(value) < kMinInt;
+      if constexpr (sizeof(I) <= sizeof(Raw)) {
+        above = Raw(value) > kMaxInt;
+        below = Raw(value) < kMinInt;
+      } else {
+        above = value > I(kMaxInt);
+        below = value < I(kMinInt);
+      }
+    } else if constexpr (sizeof(I) < sizeof(Raw)) {
+      above = Raw(value) > kMaxInt;
     } else {
-      above = static_cast<unsigned __int128>(value) > static_cast<unsigned __int128>(kMaxInt);
+      above = value > static_cast<I>(kMaxInt);
     }
     if (above || below) {
       detail::raiseFixedFault(kFixedFaultOverflow);
       return above ? std::numeric_limits<Raw>::max() : std::numeric_limits<Raw>::min();
     }
-    return static_cast<Raw>(__int128(value) * __int128(kOneRaw));
+    // In range: value fits Raw and value * 2^Frac stays within Raw's limits (no overflow).
+    return static_cast<Raw>(static_cast<Raw>(value) * kOneRaw);
   }
   /// Narrows a wide value to Raw, raising an overflow fault when it does not fit.
   static constexpr Raw narrow(Wide w) noexcept {
@@ -165,7 +192,7 @@ class Fixed {
     if constexpr (sizeof(Wide) == 16) {
       // Fast path for Q32.32: magnitudes with |n| / |d| < 2^64 divide with one 128/64 divq.
       // Same exact quotient and remainder as the generic path, so the same bits.
-      using U = unsigned __int128;
+      using U = UnsignedWideType;
       const U un = n < 0 ? U(0) - U(n) : U(n);
       const U ud = d < 0 ? U(0) - U(d) : U(d);
       if (!std::is_constant_evaluated() && (ud >> 64) == 0 && uint64_t(un >> 64) < uint64_t(ud)) {
@@ -187,44 +214,66 @@ class Fixed {
   /// (hi:lo) / d for hi < d (the quotient fits 64 bits); the remainder goes to *rem.
   static uint64_t udiv128by64(uint64_t hi, uint64_t lo, uint64_t d, uint64_t* rem) noexcept {
 #if defined(__x86_64__)
-    uint64_t q, r;
-    __asm__("divq %4" : "=a"(q), "=d"(r) : "a"(lo), "d"(hi), "rm"(d));
-    *rem = r;
-    return q;
+    // One divq; not for the portable type, so that its own division is what tests compare.
+    constexpr bool kDivq = !kIsPortableInt128<Wide>;
 #else
-    const unsigned __int128 n = (static_cast<unsigned __int128>(hi) << 64) | lo;
-    *rem = uint64_t(n % d);
-    return uint64_t(n / d);
+    constexpr bool kDivq = false;
 #endif
+    if constexpr (kDivq) {
+#if defined(__x86_64__)
+      uint64_t q, r;
+      __asm__("divq %4" : "=a"(q), "=d"(r) : "a"(lo), "d"(hi), "rm"(d));
+      *rem = r;
+      return q;
+#endif
+    } else if constexpr (kIsPortableInt128<Wide>) {
+      return portable::detail::divlu(hi, lo, d, rem);  // the portable type's own 128/64 step
+    } else {
+      using U = UnsignedWideType;
+      const U n = (static_cast<U>(hi) << 64) | lo;
+      *rem = uint64_t(n % d);
+      return uint64_t(n / d);
+    }
   }
 
  private:
   Raw raw_ = 0;
 };
 
-using Fx32 = Fixed<int64_t, __int128, 32>;
+using Fx32 = Fixed<int64_t, Int128, 32>;
 using Fx16 = Fixed<int32_t, int64_t, 16>;
 
 template <class Raw, class Wide, int Frac>
 Fixed<Raw, Wide, Frac> Fixed<Raw, Wide, Frac>::fromDouble(double v) noexcept {
-  const long double scaled = static_cast<long double>(v) * static_cast<long double>(kOneRaw);
+  // Exact in double arithmetic only (no long double, whose width differs between machines):
+  // v * 2^Frac is exact (a power-of-two scaling; an overflow gives +-inf, which fails the range
+  // test below), and the rounding works on the integer and fraction parts, both exact.
+  const double scaled = v * double(kOneRaw);
   if (scaled != scaled) {  // NaN: not representable
     detail::raiseFixedFault(kFixedFaultOverflow);
     return Fixed();
   }
-  // Guard the float -> integer conversion first (converting an out-of-range value is UB), then
-  // round in 128 bits and compare that integer exactly with the format's limits.
-  if (!(scaled > -1e37L && scaled < 1e37L)) {
+  // Guard the double -> integer conversion first (converting an out-of-range value is UB):
+  // [-2^63, 2^63) holds every value that can round into an int64 Raw, and no more.
+  constexpr double kTwo63 = 9223372036854775808.0;
+  if (!(scaled >= -kTwo63 && scaled < kTwo63)) {
     detail::raiseFixedFault(kFixedFaultOverflow);
     return v < 0 ? min() : max();
   }
-  // Nearest, ties away from zero (the cast truncates toward zero after adding the half).
-  const __int128 r = scaled < 0 ? -static_cast<__int128>(-scaled + 0.5L) : static_cast<__int128>(scaled + 0.5L);
-  if (r > __int128(std::numeric_limits<Raw>::max()) || r < __int128(std::numeric_limits<Raw>::min())) {
+  // Nearest, ties away from zero, on the magnitude. From 2^52 up a double is an integer; below,
+  // the truncated integer part r is exact, and so is mag - r (r is a multiple of mag's ulp, so
+  // the difference is a multiple of it below 1: representable), which decides against 1/2.
+  const double mag = scaled < 0 ? -scaled : scaled;
+  uint64_t r = uint64_t(mag);  // mag < 2^63
+  if (mag < 4503599627370496.0 && mag - double(r) >= 0.5) ++r;
+  const bool neg = scaled < 0;
+  constexpr uint64_t kMaxMag = uint64_t(std::numeric_limits<Raw>::max());
+  if (r > kMaxMag + (neg ? 1 : 0)) {
     detail::raiseFixedFault(kFixedFaultOverflow);
-    return v < 0 ? min() : max();
+    return neg ? min() : max();
   }
-  return fromRaw(static_cast<Raw>(r));
+  // -r as the two's complement bits (r = 2^(bits-1) gives min()); modular conversion is defined.
+  return fromRaw(static_cast<Raw>(neg ? uint64_t(0) - r : r));
 }
 
 // ---- free functions (found by argument-dependent lookup, also by Eigen) -------------------
@@ -234,30 +283,48 @@ constexpr Fixed<R, W, F> abs(Fixed<R, W, F> a) noexcept {
   return a.raw() < 0 ? -a : a;
 }
 
-/// Square root rounded to nearest; a negative argument raises a domain fault and returns 0.
-template <class R, class W, int F>
-inline Fixed<R, W, F> sqrt(Fixed<R, W, F> a) noexcept {
+namespace detail {
+/// The unsigned 128-bit type sqrt and length3 compute their radicands in: Fx32's own wide type
+/// (builtin or portable), and UInt128 for the narrower formats (Fx16's radicands need < 64
+/// bits, but the code has always used 128 and x86-64 keeps exactly that code).
+template <class W>
+using RadicandOf = std::conditional_t<sizeof(W) == 16, UnsignedOfT<W>, UInt128>;
+
+/// sqrt with the radicand type U as a parameter, so tests can run Fx16's with the portable type.
+template <class U, class R, class W, int F>
+inline Fixed<R, W, F> sqrtWith(Fixed<R, W, F> a) noexcept {
   using Fx = Fixed<R, W, F>;
   if (a.raw() < 0) {
-    detail::raiseFixedFault(kFixedFaultDomain);
+    raiseFixedFault(kFixedFaultDomain);
     return Fx();
   }
   // sqrt(raw / 2^F) * 2^F = sqrt(raw * 2^F): the radicand is exact in 128 bits.
-  const unsigned __int128 n = static_cast<unsigned __int128>(a.raw()) << F;
+  const U n = static_cast<U>(a.raw()) << F;
   return Fx::fromRaw(static_cast<R>(isqrtNearest(n)));  // < 2^(bits/2 + F/2): always fits
+}
+
+template <class U, class R, class W, int F>
+inline Fixed<R, W, F> length3With(Fixed<R, W, F> x, Fixed<R, W, F> y, Fixed<R, W, F> z) noexcept {
+  using Fx = Fixed<R, W, F>;
+  auto sq = [](R v) { const U m = v < 0 ? U(0) - U(v) : U(v); return m * m; };
+  // Each square is < 2^(2*bits-2), so the sum of three fits in 2*bits unsigned bits.
+  const uint64_t r = isqrtNearest(sq(x.raw()) + sq(y.raw()) + sq(z.raw()));
+  if (r > uint64_t(std::numeric_limits<R>::max())) raiseFixedFault(kFixedFaultOverflow);
+  return Fx::fromRaw(static_cast<R>(r));
+}
+}  // namespace detail
+
+/// Square root rounded to nearest; a negative argument raises a domain fault and returns 0.
+template <class R, class W, int F>
+inline Fixed<R, W, F> sqrt(Fixed<R, W, F> a) noexcept {
+  return detail::sqrtWith<detail::RadicandOf<W>>(a);
 }
 
 /// |(x, y, z)| rounded to nearest from the exact sum of squares (one rounding only). An axis
 /// vector (0, y, 0) has length exactly |y|.
 template <class R, class W, int F>
 inline Fixed<R, W, F> length3(Fixed<R, W, F> x, Fixed<R, W, F> y, Fixed<R, W, F> z) noexcept {
-  using Fx = Fixed<R, W, F>;
-  using U = unsigned __int128;
-  auto sq = [](R v) { const U m = v < 0 ? U(0) - U(v) : U(v); return m * m; };
-  // Each square is < 2^(2*bits-2), so the sum of three fits in 2*bits unsigned bits.
-  const uint64_t r = isqrtNearest(sq(x.raw()) + sq(y.raw()) + sq(z.raw()));
-  if (r > uint64_t(std::numeric_limits<R>::max())) detail::raiseFixedFault(kFixedFaultOverflow);
-  return Fx::fromRaw(static_cast<R>(r));
+  return detail::length3With<detail::RadicandOf<W>>(x, y, z);
 }
 
 template <class R, class W, int F>

@@ -2,13 +2,15 @@
 
 #include <cctype>
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 
 namespace sg {
 namespace {
-using I128 = __int128;
-using U128 = unsigned __int128;
+// Builtin __int128 where the compiler has it, else the portable struct (sim/math/int128.h).
+using I128 = Int128;
+using U128 = UInt128;
 
 I128 gcd(I128 a, I128 b) {
   // On magnitudes as unsigned: |INT128_MIN| is representable there.
@@ -22,7 +24,14 @@ I128 gcd(I128 a, I128 b) {
   return x > U128(~U128(0) >> 1) ? I128(1) : I128(x);  // gcd 2^127 only for (MIN, MIN/0): treat as 1
 }
 
-bool mulChecked(I128 a, I128 b, I128* out) { return !__builtin_mul_overflow(a, b, out); }
+bool mulChecked(I128 a, I128 b, I128* out) { return !mulOverflow(a, b, out); }
+
+U128 magnitude(I128 v) { return v < 0 ? U128(0) - U128(v) : U128(v); }
+
+int bitLength(U128 u) {
+  const uint64_t hi = high64(u), lo = low64(u);
+  return hi != 0 ? 128 - std::countl_zero(hi) : 64 - std::countl_zero(lo);
+}
 
 std::string toDecimalString(I128 v) {
   if (v == 0) return "0";
@@ -106,7 +115,7 @@ std::optional<Rational> parseDecimal(std::string_view t, std::string* error) {
 
 std::optional<Rational> Rational::make(I128 num, I128 den) {
   if (den == 0) return std::nullopt;
-  constexpr I128 kMin = std::numeric_limits<I128>::min();
+  constexpr I128 kMin = kInt128Min;
   if (den < 0 && (num == kMin || den == kMin)) return std::nullopt;
   if (den < 0) {
     num = -num;
@@ -141,12 +150,12 @@ std::optional<Rational> add(const Rational& a, const Rational& b) {
   const I128 ad = a.den / g, bd = b.den / g;
   I128 x, y, d, n;
   if (!mulChecked(a.num, bd, &x) || !mulChecked(b.num, ad, &y) || !mulChecked(a.den, bd, &d) ||
-      __builtin_add_overflow(x, y, &n))
+      addOverflow(x, y, &n))
     return std::nullopt;
   return Rational::make(n, d);
 }
 std::optional<Rational> sub(const Rational& a, const Rational& b) {
-  if (b.num == std::numeric_limits<I128>::min()) return std::nullopt;
+  if (b.num == kInt128Min) return std::nullopt;
   return add(a, Rational{-b.num, b.den});
 }
 std::optional<Rational> mul(const Rational& a, const Rational& b) {
@@ -159,28 +168,59 @@ std::optional<Rational> mul(const Rational& a, const Rational& b) {
   return Rational::make(n, d);
 }
 std::optional<Rational> div(const Rational& a, const Rational& b) {
-  if (b.num == 0 || b.num == std::numeric_limits<I128>::min()) return std::nullopt;
+  if (b.num == 0 || b.num == kInt128Min) return std::nullopt;
   return mul(a, Rational{b.den * (b.num < 0 ? -1 : 1), b.num < 0 ? -b.num : b.num});
 }
 int compare(const Rational& a, const Rational& b) {
-  auto d = sub(a, b);
-  if (d) return d->num < 0 ? -1 : (d->num > 0 ? 1 : 0);
-  // Too large to subtract exactly: compare via long double (only reached for absurd values).
-  const long double x = (long double)a.num / (long double)a.den;
-  const long double y = (long double)b.num / (long double)b.den;
-  return x < y ? -1 : (x > y ? 1 : 0);
+  // Exact for every pair: the signs first, then |a.num| * b.den against |b.num| * a.den as full
+  // 256-bit products (the denominators are positive), so nothing can overflow or round.
+  const int sa = a.num < 0 ? -1 : (a.num > 0 ? 1 : 0);
+  const int sb = b.num < 0 ? -1 : (b.num > 0 ? 1 : 0);
+  if (sa != sb) return sa < sb ? -1 : 1;
+  if (sa == 0) return 0;
+  U128 lhsHi, rhsHi;
+  const U128 lhsLo = mulFull(magnitude(a.num), U128(b.den), &lhsHi);
+  const U128 rhsLo = mulFull(magnitude(b.num), U128(a.den), &rhsHi);
+  const int byMagnitude = lhsHi != rhsHi ? (lhsHi < rhsHi ? -1 : 1) : (lhsLo < rhsLo ? -1 : (lhsLo > rhsLo ? 1 : 0));
+  return sa > 0 ? byMagnitude : -byMagnitude;
 }
 
 double Rational::toDouble() const {
-  constexpr I128 k2p53 = I128(1) << 53;
-  if (num > -k2p53 && num < k2p53 && den < k2p53) return double(num) / double(den);
-  return double((long double)num / (long double)den);
+  // Correctly rounded (nearest, ties to even, as IEEE division would round num / den if both
+  // were exact doubles), in integer arithmetic only: the result is the same on every machine,
+  // whatever its long double or its x87 excess precision. (Before, values beyond 2^53 went
+  // through long double: 80-bit on x86, 128-bit on aarch64/s390x, double-double on ppc64el.)
+  if (num == 0) return 0.0;
+  const U128 d = U128(den);  // den > 0
+  // Exact long division with f fraction bits: n * 2^f = q * d + r, 0 <= r < d. Add bits until q
+  // has at least 54 significant bits: 53 for the double plus the rounding bit; whether r is 0
+  // is the sticky bit. Each step brings down s bits at once, as many as r * 2^s fits 128 bits
+  // (s >= 1 since r < d < 2^127) and no more than q needs; (r * 2^s) / d < 2^s.
+  U128 q = magnitude(num) / d, r = magnitude(num) % d;
+  int f = 0;
+  for (int have = bitLength(q); have < 54; have = bitLength(q)) {
+    const int s = std::min(54 - have, 128 - bitLength(r));
+    const U128 shifted = r << s;
+    q = (q << s) | (shifted / d);
+    r = shifted % d;
+    f += s;
+  }
+  // Keep the top 53 bits of q, round on the rest: above half up, below down, an exact half
+  // (nothing below it in q and r == 0) to the even mantissa.
+  const int drop = bitLength(q) - 53;  // >= 1
+  uint64_t m = uint64_t(q >> drop);
+  const U128 rest = q & ((U128(1) << drop) - 1), half = U128(1) << (drop - 1);
+  if (rest > half || (rest == half && (r != 0 || (m & 1) != 0))) ++m;  // m <= 2^53: still exact
+  // |num/den| lies in [2^-127, 2^127): the scaling by 2^(drop - f) never overflows or goes
+  // subnormal, so ldexp is exact (it only sets the exponent).
+  const double v = std::ldexp(double(m), drop - f);
+  return num < 0 ? -v : v;
 }
 
 std::optional<I128> Rational::toScaledInteger(int fracBits) const {
   // Exact long division: integer part, then fracBits + 1 quotient bits and a sticky remainder.
   const bool neg = num < 0;
-  const U128 n = neg ? U128(0) - U128(num) : U128(num);
+  const U128 n = magnitude(num);
   const U128 d = U128(den);
   U128 q = n / d, r = n % d;
   if (fracBits >= 126 ? q != 0 : (q >> (126 - fracBits)) != 0) return std::nullopt;
@@ -194,7 +234,7 @@ std::optional<I128> Rational::toScaledInteger(int fracBits) const {
   }
   // Round half away from zero on the magnitude: compare 2r with d.
   if (r >= d - r) q += 1;
-  if (q >> 126 != 0) return std::nullopt;
+  if ((q >> 126) != 0) return std::nullopt;
   return neg ? -I128(q) : I128(q);
 }
 
@@ -251,16 +291,12 @@ I128 expNonPositive(I128 x) {
 bool mulQ62Wide(I128 a, I128 b, I128* out) {
   const I128 hi = b >> 32, lo = b & ((I128(1) << 32) - 1);
   I128 ph, pl;
-  if (__builtin_mul_overflow(a, hi, &ph) || __builtin_mul_overflow(a, lo, &pl)) return false;
+  if (mulOverflow(a, hi, &ph) || mulOverflow(a, lo, &pl)) return false;
   *out = ph / (I128(1) << 30) + pl / (I128(1) << 62);
   return true;
 }
 
-int bitLength(I128 v) {
-  int n = 0;
-  for (U128 u = U128(v); u != 0; u >>= 1) ++n;
-  return n;
-}
+int bitLength(I128 v) { return bitLength(U128(v)); }
 }  // namespace
 
 Rational deterministicPow(const Rational& base, const Rational& exponent) {

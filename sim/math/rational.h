@@ -10,13 +10,15 @@
 #include <string>
 #include <string_view>
 
+#include "sim/math/int128.h"
+
 namespace sg {
 
 struct Rational {
-  __int128 num = 0;
-  __int128 den = 1;  ///< always > 0, gcd(num, den) == 1
+  Int128 num = 0;
+  Int128 den = 1;  ///< always > 0, gcd(num, den) == 1
 
-  static std::optional<Rational> make(__int128 num, __int128 den);
+  static std::optional<Rational> make(Int128 num, Int128 den);
   static Rational integer(int64_t v) { return Rational{v, 1}; }
 
   bool isZero() const { return num == 0; }
@@ -27,10 +29,11 @@ struct Rational {
   /// text (what was expected) on failure.
   static std::optional<Rational> parse(std::string_view text, std::string* error);
 
-  /// Nearest double (correctly rounded when num and den are below 2^53, else within 1 ulp).
+  /// The double nearest to num/den, ties to even: correctly rounded, computed in integers only,
+  /// so the same on every machine (no long double, whose width differs between them).
   double toDouble() const;
   /// round(value * 2^fracBits), nearest, ties away from zero; nullopt when |result| >= 2^126.
-  std::optional<__int128> toScaledInteger(int fracBits) const;
+  std::optional<Int128> toScaledInteger(int fracBits) const;
   /// round(value), ties away from zero; nullopt when it does not fit int64.
   std::optional<int64_t> roundToInt64() const;
   std::string toString() const;

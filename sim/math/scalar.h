@@ -36,7 +36,7 @@ struct FixedTraits {
   static std::optional<Fx> fromRational(const Rational& r) {
     const auto v = r.toScaledInteger(Fx::kFracBits);
     using Raw = typename Fx::RawType;
-    if (!v || *v > __int128(std::numeric_limits<Raw>::max()) || *v < __int128(std::numeric_limits<Raw>::min()))
+    if (!v || *v > Int128(std::numeric_limits<Raw>::max()) || *v < Int128(std::numeric_limits<Raw>::min()))
       return std::nullopt;
     return Fx::fromRaw(static_cast<Raw>(*v));
   }

@@ -10,8 +10,8 @@ namespace {
 /// An exact value as its numerator and denominator, each as two 64-bit halves (low first).
 void putRational(HashSink& h, const Rational& r) {
   for (const auto& v : {r.num, r.den}) {
-    h.put(uint64_t(v));
-    h.put(uint64_t(v >> 64));
+    h.put(low64(v));
+    h.put(high64(v));
   }
 }
 

@@ -170,7 +170,7 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
   for (size_t i = 0; i < s.script.size(); ++i)
     for (int c = 0; c < 3; ++c) {
       const auto raw = s.script[i].value[size_t(c)].toScaledInteger(32);
-      if (!raw || *raw > __int128(INT64_MAX) || *raw < __int128(INT64_MIN))
+      if (!raw || *raw > Int128(INT64_MAX) || *raw < Int128(INT64_MIN))
         throw ScenarioError(s.sourceName, "$.script[" + std::to_string(i) + "].value[" + std::to_string(c) + "]",
                             "a value within +-2147483647 (inputs are Q32.32)");
     }

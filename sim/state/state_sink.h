@@ -11,7 +11,9 @@
 
 #include "sim/state/byte_order.h"
 #if defined(__x86_64__)
-#include <xxh_x86dispatch.h>  // the package's runtime AVX2/AVX-512 selection (same digests)
+// The package's runtime AVX2/AVX-512 selection (same digests). x86-64 only: the dispatcher lives
+// in libxxhash's x86-64 build, and 32-bit x86 builds (i686) link no such library.
+#include <xxh_x86dispatch.h>
 #define SG_XXH3_UPDATE XXH3_64bits_update_dispatch
 #else
 #define SG_XXH3_UPDATE XXH3_64bits_update

@@ -8,8 +8,8 @@ namespace sg {
 int64_t toInputRaw(const Rational& value) {
   const auto raw = value.toScaledInteger(32);
   if (!raw) return value.isNegative() ? std::numeric_limits<int64_t>::min() : std::numeric_limits<int64_t>::max();
-  if (*raw > __int128(std::numeric_limits<int64_t>::max())) return std::numeric_limits<int64_t>::max();
-  if (*raw < __int128(std::numeric_limits<int64_t>::min())) return std::numeric_limits<int64_t>::min();
+  if (*raw > Int128(std::numeric_limits<int64_t>::max())) return std::numeric_limits<int64_t>::max();
+  if (*raw < Int128(std::numeric_limits<int64_t>::min())) return std::numeric_limits<int64_t>::min();
   return int64_t(*raw);
 }
 
