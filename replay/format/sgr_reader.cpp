@@ -1,4 +1,5 @@
 #include "replay/format/sgr_reader.h"
+#include "sim/state/byte_order.h"
 
 #include <algorithm>
 #include <cstring>
@@ -37,8 +38,7 @@ class Cursor {
   template <class T>
   T get(const char* what) {
     need(sizeof(T), what);
-    T v;
-    std::memcpy(&v, p_.data() + at_, sizeof(T));
+    const T v = loadLE<T>(p_.data() + at_);
     at_ += sizeof(T);
     return v;
   }
@@ -213,8 +213,7 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
       throw RecordingError(file, 0, "the .sgr magic \\x89SGR\\r\\n\\x1a\\n (not a SimGrass recording)");
     throw RecordingError(file, all.size(), "the 12-byte .sgr preamble (the file ends early)");
   }
-  uint32_t version;
-  std::memcpy(&version, all.data() + 8, 4);
+  const uint32_t version = loadLE<uint32_t>(all.data() + 8);
   if (version != kFormatVersion)
     throw RecordingError(file, 8, "format version " + std::to_string(kFormatVersion) + ", got " + std::to_string(version));
 
@@ -233,9 +232,8 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
       truncate(at, "an 8-byte chunk header");
       break;
     }
-    uint32_t type, length;
-    std::memcpy(&type, all.data() + at, 4);
-    std::memcpy(&length, all.data() + at + 4, 4);
+    const uint32_t type = loadLE<uint32_t>(all.data() + at);
+    const uint32_t length = loadLE<uint32_t>(all.data() + at + 4);
     if (!knownType(type)) throw RecordingError(file, at, "a chunk type HEAD, INPT, CHCK, SNAP or END, got " + typeText(type));
     const ChunkType t = ChunkType(type);
     if (length > maxPayload(t))
@@ -247,8 +245,7 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
                        std::to_string(all.size() - at) + " left");
       break;
     }
-    uint64_t stored;
-    std::memcpy(&stored, all.data() + at + kChunkHeaderBytes + length, 8);
+    const uint64_t stored = loadLE<uint64_t>(all.data() + at + kChunkHeaderBytes + length);
     if (XXH3_64bits(all.data() + at, kChunkHeaderBytes + length) != stored)
       throw RecordingError(file, at + kChunkHeaderBytes + length,
                            std::string("the ") + chunkTypeName(t) + " chunk's checksum (the chunk at byte " +

@@ -1,4 +1,5 @@
 #include "replay/format/sgr_writer.h"
+#include "sim/state/byte_order.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -12,14 +13,13 @@
 
 namespace sg::sgr {
 namespace {
-// Little-endian append helpers (every supported target is little-endian; static_assert below).
-static_assert(std::endian::native == std::endian::little, "the .sgr writer assumes a little-endian host");
-
+// Little-endian append helpers: explicit byte order, so a recording made on a big-endian host
+// (s390x) is the same bytes as one made on x86-64.
 template <class T>
 void put(std::vector<uint8_t>& out, T value) {
   const size_t at = out.size();
   out.resize(at + sizeof(T));
-  std::memcpy(out.data() + at, &value, sizeof(T));
+  storeLE(out.data() + at, value);
 }
 void putString(std::vector<uint8_t>& out, const std::string& s) {
   put<uint32_t>(out, uint32_t(s.size()));

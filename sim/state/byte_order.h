@@ -6,7 +6,6 @@
 // one call: the state hash streams ~50 MB per tick at a million particles).
 #pragma once
 
-#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -14,7 +13,9 @@
 
 namespace sg {
 
-inline constexpr bool kHostIsLittleEndian = std::endian::native == std::endian::little;
+// The compilers' predefined macros (GCC, Clang, emscripten), not std::endian: one less library
+// feature for the older cross toolchains to lack.
+inline constexpr bool kHostIsLittleEndian = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
 
 /// The unsigned integer of the same width as T (T: an integer, float or double).
 template <class T>
@@ -28,7 +29,8 @@ template <class T>
 inline void storeLE(uint8_t* out, T v) {
   static_assert(sizeof(T) <= 8 && std::is_trivially_copyable_v<T>);
   using U = UnsignedOfSize<T>;
-  const U u = std::bit_cast<U>(v);
+  U u;
+  std::memcpy(&u, &v, sizeof u);  // std::bit_cast, which emscripten 3.1.6's libc++ lacks
   for (size_t i = 0; i < sizeof(T); ++i) out[i] = uint8_t(u >> (8 * i));
 }
 
@@ -39,7 +41,9 @@ inline T loadLE(const uint8_t* in) {
   using U = UnsignedOfSize<T>;
   U u = 0;
   for (size_t i = 0; i < sizeof(T); ++i) u = U(u | U(U(in[i]) << (8 * i)));
-  return std::bit_cast<T>(u);
+  T v;
+  std::memcpy(&v, &u, sizeof v);
+  return v;
 }
 
 }  // namespace sg
