@@ -10,8 +10,8 @@
 #include <string>
 
 #include "sim/lod/edge_ring.h"
-#include "sim/world/world.h"
 #include "sim/world/tick_input.h"
+#include "sim/world/world.h"
 
 namespace {
 
@@ -42,7 +42,8 @@ void BM_WindowTick(benchmark::State& state) {
   int64_t cameraRow = 0;
   // On particle rows (the field's rows sit at -199.95 + 0.1 j), never on a border between two.
   auto place = [&] {
-    in.camera = sg::InputVec3{0, 0, sg::toInputRaw(*sg::add(*sg::Rational::make(-2999, 20), *sg::Rational::make(cameraRow, 10)))};
+    in.camera = sg::InputVec3{
+        0, 0, sg::toInputRaw(*sg::add(*sg::Rational::make(-2999, 20), *sg::Rational::make(cameraRow, 10)))};
   };
   place();
   for (int t = 0; t < 5; ++t) world->step(in);
@@ -59,12 +60,17 @@ void BM_WindowTick(benchmark::State& state) {
   }
   const int64_t moved = world->counts().windowOriginJ - origin;
   if (shift && moved != int64_t(state.iterations()))
-    state.SkipWithError(("the window moved " + std::to_string(moved) + " rows in " + std::to_string(state.iterations()) + " ticks").c_str());
+    state.SkipWithError(
+        ("the window moved " + std::to_string(moved) + " rows in " + std::to_string(state.iterations()) + " ticks")
+            .c_str());
   state.counters["rows_shifted"] = double(moved);
   state.counters["window_patches"] = double(world->counts().simulatedPatches());
 }
-BENCHMARK(BM_WindowTick)->ArgsProduct({{0, 1}, {1, 2}})->ArgNames({"shift", "threads"})
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_WindowTick)
+    ->ArgsProduct({{0, 1}, {1, 2}})
+    ->ArgNames({"shift", "threads"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void BM_EdgeRingShift(benchmark::State& state) {
   using S = sg::Fx32;

@@ -22,7 +22,8 @@
 namespace {
 
 std::string scratchFile(const char* name) {
-  return (std::filesystem::temp_directory_path() / (std::string("simgrass-bench-") + std::to_string(getpid()) + "-" + name))
+  return (std::filesystem::temp_directory_path() /
+          (std::string("simgrass-bench-") + std::to_string(getpid()) + "-" + name))
       .string();
 }
 
@@ -33,7 +34,9 @@ void BM_RecordTick(benchmark::State& state) {
   auto world = sg::makeWorld(s, threads);
   const std::string path = scratchFile("record.sgr");
   std::unique_ptr<sg::Recorder> recorder;
-  if (recording) recorder = std::make_unique<sg::Recorder>(path, s, std::vector<sg::sgr::EmbeddedFile>{}, *world, sg::RecordSettings{});
+  if (recording)
+    recorder =
+        std::make_unique<sg::Recorder>(path, s, std::vector<sg::sgr::EmbeddedFile>{}, *world, sg::RecordSettings{});
   for (auto _ : state) {
     const sg::TickInput input = sg::scriptedInput(s, world->tick());
     const sg::StepResult r = recording ? recorder->step(input) : world->step(input);
@@ -45,8 +48,12 @@ void BM_RecordTick(benchmark::State& state) {
   }
   std::filesystem::remove(path);
 }
-BENCHMARK(BM_RecordTick)->ArgsProduct({{0, 1}, {1, 2}})->ArgNames({"record", "threads"})
-    ->Unit(benchmark::kMicrosecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK(BM_RecordTick)
+    ->ArgsProduct({{0, 1}, {1, 2}})
+    ->ArgNames({"record", "threads"})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
 
 void BM_Seek(benchmark::State& state) {
   const sg::Scenario s = sg::parseScenario(sg::defaultScenarioText(), "<built-in>", {});

@@ -36,9 +36,9 @@
 #include <thread>
 #include <vector>
 
+#include "bench/bench_support.h"
 #include "sim/collision/body_pairs.h"
 #include "sim/collision/body_particles.h"
-#include "bench/bench_support.h"
 #include "sim/world/world.h"
 
 namespace {
@@ -66,13 +66,15 @@ sg::Scenario meadow(int64_t side, int k, ScalarKind scalar, bool bodies, bool br
 void patchCounters(benchmark::State& state, const sg::SimWorld& world) {
   const double patches = double(world.counts().patches());
   state.counters["patches"] = patches;
-  state.counters["patch_steps/s"] = benchmark::Counter(patches * double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["patch_steps/s"] =
+      benchmark::Counter(patches * double(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["bytes/patch"] = double(world.saveState().size()) / patches;
 }
 
 void stageCounters(benchmark::State& state, const StageTimer& timer) {
   for (size_t s = 0; s < size_t(sg::Stage::Count); ++s)
-    state.counters[std::string(sg::stageName(sg::Stage(s))) + "_ms"] = timer.nanos[s] / 1e6 / double(state.iterations());
+    state.counters[std::string(sg::stageName(sg::Stage(s))) + "_ms"] =
+        timer.nanos[s] / 1e6 / double(state.iterations());
 }
 
 // ---- whole ticks, split by stage -------------------------------------------------------------
@@ -152,18 +154,24 @@ void BM_BroadPhase(benchmark::State& state) {
   int64_t candidates = 0;
   for (auto _ : state) {
     const std::vector<sg::ParticleRange> ranges = sg::particleRanges(world.bodies(), grid, settings);
-    benchmark::DoNotOptimize(sg::pushParticlesOutOfBodies(particles, grid, world.bodies(), ranges, settings, 0,
-                                                          grid.countZ, nullptr));
+    benchmark::DoNotOptimize(
+        sg::pushParticlesOutOfBodies(particles, grid, world.bodies(), ranges, settings, 0, grid.countZ, nullptr));
     candidates = 0;
     for (const sg::ParticleRange& r : ranges) candidates += (r.a1 - r.a0 + 1) * (r.b1 - r.b0 + 1);
   }
   state.counters["particles"] = double(grid.size());
   state.counters["candidate_cells"] = double(candidates);
 }
-BENCHMARK_TEMPLATE(BM_BroadPhase, sg::Fx32)->ArgsProduct({{151, 1000}, {0, 1}})->ArgNames({"side", "brute"})
-    ->Unit(benchmark::kMicrosecond)->Name("BM_BroadPhase/fx32");
-BENCHMARK_TEMPLATE(BM_BroadPhase, sg::Fx16)->ArgsProduct({{151, 1000}, {0, 1}})->ArgNames({"side", "brute"})
-    ->Unit(benchmark::kMicrosecond)->Name("BM_BroadPhase/fx16");
+BENCHMARK_TEMPLATE(BM_BroadPhase, sg::Fx32)
+    ->ArgsProduct({{151, 1000}, {0, 1}})
+    ->ArgNames({"side", "brute"})
+    ->Unit(benchmark::kMicrosecond)
+    ->Name("BM_BroadPhase/fx32");
+BENCHMARK_TEMPLATE(BM_BroadPhase, sg::Fx16)
+    ->ArgsProduct({{151, 1000}, {0, 1}})
+    ->ArgNames({"side", "brute"})
+    ->Unit(benchmark::kMicrosecond)
+    ->Name("BM_BroadPhase/fx16");
 
 /// Narrow phase: contacts of every body pair and of every body with the terrain.
 template <class S>
@@ -177,8 +185,7 @@ void BM_NarrowPhase(benchmark::State& state) {
     contacts.clear();
     for (const auto& [i, j] : sg::bodyPairs(bodies, sg::BodyBroadphase::Brute))
       sg::collideBodies(i, bodies[size_t(i)], j, bodies[size_t(j)], contacts);
-    for (size_t i = 0; i < bodies.size(); ++i)
-      sg::collideBodyTerrain(int32_t(i), bodies[i], world.terrain(), contacts);
+    for (size_t i = 0; i < bodies.size(); ++i) sg::collideBodyTerrain(int32_t(i), bodies[i], world.terrain(), contacts);
     benchmark::DoNotOptimize(contacts.data());
   }
   state.counters["contacts"] = double(contacts.size());
@@ -195,9 +202,15 @@ void BM_State(benchmark::State& state, ScalarKind scalar, StateOp op) {
   const std::vector<uint8_t> saved = world->saveState();
   for (auto _ : state) {
     switch (op) {
-      case StateOp::Hash: benchmark::DoNotOptimize(world->stateHash()); break;
-      case StateOp::Save: benchmark::DoNotOptimize(world->saveState().data()); break;
-      case StateOp::Restore: world->restoreState(saved); break;
+      case StateOp::Hash:
+        benchmark::DoNotOptimize(world->stateHash());
+        break;
+      case StateOp::Save:
+        benchmark::DoNotOptimize(world->saveState().data());
+        break;
+      case StateOp::Restore:
+        world->restoreState(saved);
+        break;
     }
   }
   state.SetBytesProcessed(int64_t(saved.size()) * int64_t(state.iterations()));
@@ -207,10 +220,11 @@ void BM_State(benchmark::State& state, ScalarKind scalar, StateOp op) {
 void stateSizes(benchmark::internal::Benchmark* b) {
   b->Arg(151)->Arg(500)->Arg(1000)->Arg(2000)->ArgName("side")->Unit(benchmark::kMillisecond)->UseRealTime();
 }
-BENCHMARK_CAPTURE(BM_State, hash/fx32, ScalarKind::Fx32, StateOp::Hash)->Apply(stateSizes)->Name("BM_StateHash/fx32");
-BENCHMARK_CAPTURE(BM_State, hash/fx16, ScalarKind::Fx16, StateOp::Hash)->Apply(stateSizes)->Name("BM_StateHash/fx16");
-BENCHMARK_CAPTURE(BM_State, save/fx32, ScalarKind::Fx32, StateOp::Save)->Apply(stateSizes)->Name("BM_SaveState/fx32");
-BENCHMARK_CAPTURE(BM_State, restore/fx32, ScalarKind::Fx32, StateOp::Restore)->Apply(stateSizes)
+BENCHMARK_CAPTURE(BM_State, hash / fx32, ScalarKind::Fx32, StateOp::Hash)->Apply(stateSizes)->Name("BM_StateHash/fx32");
+BENCHMARK_CAPTURE(BM_State, hash / fx16, ScalarKind::Fx16, StateOp::Hash)->Apply(stateSizes)->Name("BM_StateHash/fx16");
+BENCHMARK_CAPTURE(BM_State, save / fx32, ScalarKind::Fx32, StateOp::Save)->Apply(stateSizes)->Name("BM_SaveState/fx32");
+BENCHMARK_CAPTURE(BM_State, restore / fx32, ScalarKind::Fx32, StateOp::Restore)
+    ->Apply(stateSizes)
     ->Name("BM_RestoreState/fx32");
 
 // ---- memory bandwidth and the particle stages against it -------------------------------------
@@ -222,7 +236,8 @@ void parallelCopy(std::vector<char>& dst, const std::vector<char>& src, int thre
   const size_t slice = src.size() / size_t(threads);
   std::vector<std::thread> workers;
   for (int t = 1; t < threads; ++t)
-    workers.emplace_back([&, t] { std::memcpy(dst.data() + slice * size_t(t), src.data() + slice * size_t(t), slice); });
+    workers.emplace_back(
+        [&, t] { std::memcpy(dst.data() + slice * size_t(t), src.data() + slice * size_t(t), slice); });
   std::memcpy(dst.data(), src.data(), slice);
   for (std::thread& w : workers) w.join();
 }
@@ -292,9 +307,19 @@ void kernelArgs(benchmark::internal::Benchmark* b) {
 }
 BENCHMARK_TEMPLATE(BM_IntegrateConstraints, sg::Fx32)->Apply(kernelArgs)->Name("BM_IntegrateConstraints/fx32");
 BENCHMARK_TEMPLATE(BM_IntegrateConstraints, sg::Fx16)->Apply(kernelArgs)->Name("BM_IntegrateConstraints/fx16");
-BENCHMARK_TEMPLATE(BM_IntegrateConstraints, float)->Args({1, 0})->Args({2, 0})->ArgNames({"threads", "avx2"})
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->Name("BM_IntegrateConstraints/float");
-BENCHMARK_TEMPLATE(BM_IntegrateConstraints, double)->Args({1, 0})->Args({2, 0})->ArgNames({"threads", "avx2"})
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->Name("BM_IntegrateConstraints/double");
+BENCHMARK_TEMPLATE(BM_IntegrateConstraints, float)
+    ->Args({1, 0})
+    ->Args({2, 0})
+    ->ArgNames({"threads", "avx2"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Name("BM_IntegrateConstraints/float");
+BENCHMARK_TEMPLATE(BM_IntegrateConstraints, double)
+    ->Args({1, 0})
+    ->Args({2, 0})
+    ->ArgNames({"threads", "avx2"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Name("BM_IntegrateConstraints/double");
 
 }  // namespace

@@ -1,9 +1,9 @@
 // One full tick, per scalar, field size, interpolation k and thread count (issue: core).
 // Counters: patch_steps/s (patches advanced per second) and ticks/s.
 //   build/release/bench/simgrass_bench --benchmark_filter=Tick
+#include <benchmark/benchmark.h>
 #include <cstdio>
 #include "replay/kernel_environment.h"
-#include <benchmark/benchmark.h>
 
 #include <map>
 #include <memory>
@@ -33,12 +33,13 @@ void BM_Tick(benchmark::State& state, sg::ScalarKind scalar) {
   }
   const double patches = double(side * side);
   state.counters["patches"] = patches;
-  state.counters["patch_steps/s"] = benchmark::Counter(patches * double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["patch_steps/s"] =
+      benchmark::Counter(patches * double(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["ticks/s"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 void sizes(benchmark::internal::Benchmark* b) {
-  for (int64_t side : {151, 1000})      // 22,801 (thesis) and 1,000,000 patches
+  for (int64_t side : {151, 1000})  // 22,801 (thesis) and 1,000,000 patches
     for (int k : {1, 2})
       for (int threads : {1, 2}) b->Args({side, k, threads});
   b->ArgNames({"side", "k", "threads"})->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -122,8 +122,10 @@ namespace {
 std::string metres(double v) {
   char buf[40];
   if (v == 0) return "0 m";
-  if (std::fabs(v) >= 1e-2 && std::fabs(v) < 1e4) std::snprintf(buf, sizeof buf, "%.4g m", v);
-  else std::snprintf(buf, sizeof buf, "%.3e m", v);
+  if (std::fabs(v) >= 1e-2 && std::fabs(v) < 1e4)
+    std::snprintf(buf, sizeof buf, "%.4g m", v);
+  else
+    std::snprintf(buf, sizeof buf, "%.3e m", v);
   return buf;
 }
 

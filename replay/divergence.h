@@ -12,16 +12,16 @@ namespace sg {
 
 /// The divergence between two observations of the same field at one common time.
 struct TickDivergence {
-  int64_t tick = 0;          ///< in the reference's (A's, the recording's) time base
-  double tipMax = 0;         ///< m: largest distance between corresponding tuft tips
-  double tipRms = 0;         ///< m: root mean square of that distance over all patches
-  double bodyPosMax = 0;     ///< m: largest distance between corresponding body centres
-  double bodyAngleMax = 0;   ///< rad: largest angle of the relative rotation of a body (0 … pi)
+  int64_t tick = 0;                      ///< in the reference's (A's, the recording's) time base
+  double tipMax = 0;                     ///< m: largest distance between corresponding tuft tips
+  double tipRms = 0;                     ///< m: root mean square of that distance over all patches
+  double bodyPosMax = 0;                 ///< m: largest distance between corresponding body centres
+  double bodyAngleMax = 0;               ///< rad: largest angle of the relative rotation of a body (0 … pi)
   int64_t contactsA = 0, contactsB = 0;  ///< body contacts found in the tick that led here
   /// Bodies in each run (spawn commands add bodies mid-run): the pose errors cover the bodies
   /// both runs have (the same indices); a body only one run has counts as a difference.
   int64_t bodiesA = 0, bodiesB = 0;
-  bool identical = false;    ///< the two state hashes are equal
+  bool identical = false;  ///< the two state hashes are equal
 
   /// Anything measured differs (tips, body poses, body or contact counts).
   bool observedDifference() const {
@@ -31,13 +31,13 @@ struct TickDivergence {
 
 /// Divergence over a run: the largest per-tick errors and the first ticks things differ.
 struct DivergenceSummary {
-  int64_t ticks = 0;            ///< ticks measured
-  double tipMax = 0;            ///< m: largest TickDivergence::tipMax (NaN if any was)
-  int64_t tipMaxTick = -1;      ///< first tick with that value
-  double tipSumSquares = 0;     ///< sum over ticks of tipRms^2 (all ticks have the same patches)
-  double bodyPosMax = 0;        ///< m
-  double bodyAngleMax = 0;      ///< rad
-  int64_t contactDeltaMax = 0;  ///< largest |contactsA - contactsB|
+  int64_t ticks = 0;               ///< ticks measured
+  double tipMax = 0;               ///< m: largest TickDivergence::tipMax (NaN if any was)
+  int64_t tipMaxTick = -1;         ///< first tick with that value
+  double tipSumSquares = 0;        ///< sum over ticks of tipRms^2 (all ticks have the same patches)
+  double bodyPosMax = 0;           ///< m
+  double bodyAngleMax = 0;         ///< rad
+  int64_t contactDeltaMax = 0;     ///< largest |contactsA - contactsB|
   int64_t firstObservedTick = -1;  ///< first tick whose tips, body poses or contact counts differ
   int64_t firstHashTick = -1;      ///< first tick whose state hashes differ
 

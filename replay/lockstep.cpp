@@ -31,12 +31,13 @@ RecordedHashes::RecordedHashes(const sgr::Recording& r) {
   byTick_.insert(byTick_.end(), r.checks.begin(), r.checks.end());
   for (const sgr::SnapshotInfo& s : r.snapshots) byTick_.push_back({s.tick, s.hash});
   if (r.end && !r.end->faulted) byTick_.push_back({r.end->tick, r.end->hash});
-  std::stable_sort(byTick_.begin(), byTick_.end(), [](const sgr::Check& a, const sgr::Check& b) { return a.tick < b.tick; });
+  std::stable_sort(byTick_.begin(), byTick_.end(),
+                   [](const sgr::Check& a, const sgr::Check& b) { return a.tick < b.tick; });
 }
 
 std::optional<uint64_t> RecordedHashes::at(int64_t tick) const {
-  auto it = std::lower_bound(byTick_.begin(), byTick_.end(), tick,
-                             [](const sgr::Check& c, int64_t t) { return c.tick < t; });
+  auto it =
+      std::lower_bound(byTick_.begin(), byTick_.end(), tick, [](const sgr::Check& c, int64_t t) { return c.tick < t; });
   if (it == byTick_.end() || it->tick != tick) return std::nullopt;
   return it->hash;
 }
@@ -44,7 +45,8 @@ std::optional<uint64_t> RecordedHashes::at(int64_t tick) const {
 TimeRatio lockStepRatio(const Rational& recordedDt, const Rational& runDt) {
   const std::optional<TimeRatio> r = lineUp(recordedDt, runDt);
   if (!r)
-    throw std::invalid_argument("dt=" + runDt.toString() + ": expected a time step that is a whole multiple or a whole " +
+    throw std::invalid_argument("dt=" + runDt.toString() +
+                                ": expected a time step that is a whole multiple or a whole " +
                                 "fraction of the recording's dt=" + recordedDt.toString());
   return *r;
 }

@@ -13,7 +13,8 @@ namespace sg {
 /// the file and what went wrong, and leaves no temporary file and no partial target behind.
 bool writeFileAtomic(const std::string& path, std::span<const uint8_t> bytes, std::string* error);
 inline bool writeFileAtomic(const std::string& path, const std::string& text, std::string* error) {
-  return writeFileAtomic(path, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(text.data()), text.size()), error);
+  return writeFileAtomic(path, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(text.data()), text.size()),
+                         error);
 }
 
 }  // namespace sg

@@ -52,7 +52,8 @@ Player::Player(const sgr::Recording& recording, int threads, const VariantSettin
     // asks for more is an error here, not a failed allocation later.
     world_ = makeWorld(scenario_, threads_, physicalMemoryBytes());
   } catch (const ScenarioError& e) {
-    throw sgr::RecordingError(recording.file, sgr::kPreambleBytes, std::string("a scenario this build can run: ") + e.what());
+    throw sgr::RecordingError(recording.file, sgr::kPreambleBytes,
+                              std::string("a scenario this build can run: ") + e.what());
   }
   // Spawn commands add bodies up to kMaxBodies: commands may name those indices too.
   const int64_t bodies = std::max<int64_t>(world_->counts().bodies, kMaxBodies);
@@ -68,9 +69,7 @@ Player::Player(const sgr::Recording& recording, int threads, const VariantSettin
                               "the physics or the scenario format changed since it was recorded)");
 }
 
-void Player::restart() {
-  world_ = makeWorld(scenario_, threads_);
-}
+void Player::restart() { world_ = makeWorld(scenario_, threads_); }
 
 StepResult Player::stepForward(StageObserver* observer) {
   return world_->step(recording_.inputAt(world_->tick()), observer);
@@ -118,7 +117,8 @@ VerifyReport Player::verify(const std::function<void(int64_t)>& progress) {
   std::vector<sgr::Check> expected = recording_.checks;
   for (const sgr::SnapshotInfo& s : recording_.snapshots) expected.push_back({s.tick, s.hash});
   if (recording_.end && !recording_.end->faulted) expected.push_back({recording_.end->tick, recording_.end->hash});
-  std::stable_sort(expected.begin(), expected.end(), [](const sgr::Check& a, const sgr::Check& b) { return a.tick < b.tick; });
+  std::stable_sort(expected.begin(), expected.end(),
+                   [](const sgr::Check& a, const sgr::Check& b) { return a.tick < b.tick; });
   size_t next = 0;
   // Snapshots are what seeking restores, and their hash (checked above) says nothing about their
   // bytes: each must decompress (a damaged frame throws RecordingError) and, when this world runs

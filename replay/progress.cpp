@@ -6,8 +6,11 @@
 
 namespace sg {
 ProgressBar::ProgressBar(std::string label, int64_t total, bool enabled)
-    : label_(std::move(label)), total_(total), enabled_(enabled && isatty(STDERR_FILENO) && total > 0),
-      start_(std::chrono::steady_clock::now()), lastDraw_(start_) {}
+    : label_(std::move(label)),
+      total_(total),
+      enabled_(enabled && isatty(STDERR_FILENO) && total > 0),
+      start_(std::chrono::steady_clock::now()),
+      lastDraw_(start_) {}
 
 ProgressBar::~ProgressBar() { finish(); }
 

@@ -50,7 +50,10 @@ sgr::Header makeHeader(const Scenario& scenario, std::vector<sgr::EmbeddedFile> 
 
 Recorder::Recorder(const std::string& path, const Scenario& scenario, std::vector<sgr::EmbeddedFile> files,
                    SimWorld& world, const RecordSettings& settings)
-    : world_(world), settings_(settings), startTick_(world.tick()), writer_(path, makeHeader(scenario, std::move(files), world, settings)) {
+    : world_(world),
+      settings_(settings),
+      startTick_(world.tick()),
+      writer_(path, makeHeader(scenario, std::move(files), world, settings)) {
   writer_.zstdLevel = settings.zstdLevel;
 }
 

@@ -29,8 +29,8 @@ class Recorder {
  public:
   /// `scenario` has the variant already applied; `files` are the files it named (embedded).
   /// Writes HEAD with the world's current state hash. Throws std::runtime_error on I/O errors.
-  Recorder(const std::string& path, const Scenario& scenario, std::vector<sgr::EmbeddedFile> files,
-           SimWorld& world, const RecordSettings& settings);
+  Recorder(const std::string& path, const Scenario& scenario, std::vector<sgr::EmbeddedFile> files, SimWorld& world,
+           const RecordSettings& settings);
   ~Recorder();  ///< a recorder destroyed without finish() leaves a truncated (still readable) file
 
   /// One tick: records the input, steps the world, writes CHCK/SNAP when due, flushes.

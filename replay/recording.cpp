@@ -23,7 +23,7 @@ struct RecordingSession::Impl {
   }
 
   Scenario scenario;
-  std::unique_ptr<SimWorld> world;     // declared before the recorder, which holds a reference to it
+  std::unique_ptr<SimWorld> world;  // declared before the recorder, which holds a reference to it
   std::unique_ptr<Recorder> recorder;
   StepResult last;
   std::string error;  ///< last.error.message() once a step faulted

@@ -23,9 +23,10 @@ class SimWorld;  // sim/world/sim_world.h: include it to read a session's world
 
 /// How a new recording is written (the defaults are `simgrass record`'s).
 struct RecordingSettings {
-  int threads = 1;                     ///< worker threads; the recording is the same for any count
-  std::optional<uint32_t> checkEvery;  ///< ticks between state hashes (0: none); unset: 1 up to ~130,000 patches, then fewer
-  uint32_t snapshotEvery = 300;        ///< ticks between compressed state snapshots (0: none)
+  int threads = 1;  ///< worker threads; the recording is the same for any count
+  std::optional<uint32_t>
+      checkEvery;                ///< ticks between state hashes (0: none); unset: 1 up to ~130,000 patches, then fewer
+  uint32_t snapshotEvery = 300;  ///< ticks between compressed state snapshots (0: none)
 };
 
 /// Where a session or a recording ended.
@@ -88,9 +89,9 @@ struct RecordingInfo {
   int64_t startTick = 0, lastTick = 0;
   uint32_t checkEvery = 0, snapshotEvery = 0;
   int64_t inputs = 0, checks = 0, snapshots = 0;  ///< chunks of each kind
-  bool complete = false;             ///< ends with END
-  std::optional<uint64_t> finalHash; ///< END's state hash, when it ended without a fault
-  std::string fault;                 ///< the fault the recording stopped on; empty when none
+  bool complete = false;                          ///< ends with END
+  std::optional<uint64_t> finalHash;              ///< END's state hash, when it ended without a fault
+  std::string fault;                              ///< the fault the recording stopped on; empty when none
 };
 
 /// Reads a recording's chunks (every checksum and field checked). Throws std::runtime_error
@@ -101,13 +102,13 @@ RecordingInfo readRecordingInfo(const std::string& path);
 
 /// The outcome of replaying a recording against every hash it holds.
 struct VerifyResult {
-  bool ok = true;                ///< every recorded hash matched (and a recorded fault recurred)
-  int64_t ticks = 0;             ///< ticks replayed
-  int64_t hashesChecked = 0;     ///< CHCK/SNAP/END hashes that matched
+  bool ok = true;             ///< every recorded hash matched (and a recorded fault recurred)
+  int64_t ticks = 0;          ///< ticks replayed
+  int64_t hashesChecked = 0;  ///< CHCK/SNAP/END hashes that matched
   int64_t firstMismatchTick = -1;
   uint64_t expectedHash = 0, actualHash = 0;  ///< at firstMismatchTick, for a hash mismatch
-  std::string error;             ///< the replay faulted where the recording did not
-  uint64_t finalHash = 0;        ///< the replayed state's hash where the replay stopped
+  std::string error;                          ///< the replay faulted where the recording did not
+  uint64_t finalHash = 0;                     ///< the replayed state's hash where the replay stopped
 };
 
 /// Rebuilds the recorded world and replays it from start to end (`simgrass replay --verify`).

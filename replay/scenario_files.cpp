@@ -38,7 +38,8 @@ Scenario loadScenarioFile(const std::string& path, std::vector<sgr::EmbeddedFile
   if (bytes.size() > (size_t(64) << 20)) throw ScenarioError(path, "$", "a scenario file under 64 MiB");
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
   auto readRelative = [dir, files](const std::string& name, std::vector<uint8_t>* out, std::string* why) {
-    const std::filesystem::path p = std::filesystem::path(name).is_absolute() ? std::filesystem::path(name) : dir / name;
+    const std::filesystem::path p =
+        std::filesystem::path(name).is_absolute() ? std::filesystem::path(name) : dir / name;
     if (!readBytes(p, out, why)) return false;
     if (files) files->push_back(sgr::EmbeddedFile{name, *out});
     return true;

@@ -14,8 +14,9 @@ class StageClock final : public StageObserver {
  public:
   void stageBegin(Stage s) override { begin_[size_t(s)] = std::chrono::steady_clock::now(); }
   void stageEnd(Stage s) override {
-    nanos[size_t(s)] += uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                     std::chrono::steady_clock::now() - begin_[size_t(s)]).count());
+    nanos[size_t(s)] += uint64_t(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - begin_[size_t(s)])
+            .count());
   }
   std::array<uint64_t, size_t(Stage::Count)> nanos{};
 

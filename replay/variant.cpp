@@ -32,13 +32,19 @@ VariantSettings VariantSettings::parse(const std::string& text) {
       if (value.size() != 1 || value[0] < '1' || value[0] > '4') bad(item, "interp=1, 2, 3 or 4");
       v.interpolation = value[0] - '0';
     } else if (key == "broadphase") {
-      if (value == "grid") v.broadphase = ParticleBroadphase::Grid;
-      else if (value == "brute") v.broadphase = ParticleBroadphase::Brute;
-      else bad(item, "broadphase=grid or brute");
+      if (value == "grid")
+        v.broadphase = ParticleBroadphase::Grid;
+      else if (value == "brute")
+        v.broadphase = ParticleBroadphase::Brute;
+      else
+        bad(item, "broadphase=grid or brute");
     } else if (key == "body-broadphase") {
-      if (value == "brute") v.bodyBroadphase = BodyBroadphase::Brute;
-      else if (value == "sap") v.bodyBroadphase = BodyBroadphase::SweepAndPrune;
-      else bad(item, "body-broadphase=brute or sap");
+      if (value == "brute")
+        v.bodyBroadphase = BodyBroadphase::Brute;
+      else if (value == "sap")
+        v.bodyBroadphase = BodyBroadphase::SweepAndPrune;
+      else
+        bad(item, "body-broadphase=brute or sap");
     } else if (key == "dt") {
       std::string why;
       const auto dt = Rational::parse(value, &why);
@@ -55,9 +61,12 @@ VariantSettings VariantSettings::parse(const std::string& text) {
       if (n < 1 || n > 256) bad(item, "threads=1..256");
       v.threads = n;
     } else if (key == "lod") {
-      if (value == "off") v.lod = LodMode::Off;
-      else if (value == "window") v.lod = LodMode::Window;
-      else bad(item, "lod=off or window");
+      if (value == "off")
+        v.lod = LodMode::Off;
+      else if (value == "window")
+        v.lod = LodMode::Window;
+      else
+        bad(item, "lod=off or window");
     } else {
       bad(item, "a key scalar, interp, broadphase, body-broadphase, dt, lod or threads");
     }

@@ -14,12 +14,12 @@ namespace sg {
 
 struct VariantSettings {
   std::optional<ScalarKind> scalar;
-  std::optional<int> interpolation;               ///< k, 1..4
-  std::optional<ParticleBroadphase> broadphase;   ///< particles vs bodies
-  std::optional<BodyBroadphase> bodyBroadphase;   ///< bodies vs bodies
-  std::optional<Rational> timeStep;               ///< s per tick
-  std::optional<int> threads;                     ///< not part of the state: must be bit-identical
-  std::optional<LodMode> lod;                     ///< off: the whole field; window: around the camera
+  std::optional<int> interpolation;              ///< k, 1..4
+  std::optional<ParticleBroadphase> broadphase;  ///< particles vs bodies
+  std::optional<BodyBroadphase> bodyBroadphase;  ///< bodies vs bodies
+  std::optional<Rational> timeStep;              ///< s per tick
+  std::optional<int> threads;                    ///< not part of the state: must be bit-identical
+  std::optional<LodMode> lod;                    ///< off: the whole field; window: around the camera
 
   /// Parses "interp=2", "scalar=fx16,dt=1/120", ...; later keys override earlier ones.
   /// Throws std::invalid_argument with "key=value: expected ..." on a bad setting.

@@ -32,7 +32,8 @@ struct PixelRect {
 PixelRect pixels(const TuftAtlas& atlas, int variant, int level) {
   const TuftAtlas::Rect r = atlas.tile(variant, level);
   const float w = float(atlas.image.width), h = float(atlas.image.height);
-  return {int(std::lround(r.u0 * w)), int(std::lround(r.v0 * h)), int(std::lround(r.u1 * w)), int(std::lround(r.v1 * h))};
+  return {int(std::lround(r.u0 * w)), int(std::lround(r.v0 * h)), int(std::lround(r.u1 * w)),
+          int(std::lround(r.v1 * h))};
 }
 
 double opaqueFraction(const TuftAtlas& atlas, int variant, int level) {
@@ -307,12 +308,14 @@ TEST(GroundTexture, MeanColourIsTheGrassDarkened) {
   // Still greenish (soil patches shift it toward brown, not away from green).
   EXPECT_GT(ground[1], ground[0]);
   EXPECT_GT(ground[1], ground[2]);
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(ground[size_t(c)], kGroundDarkening * grass[size_t(c)], 0.3f * kGroundDarkening * grass[1]) << c;
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(ground[size_t(c)], kGroundDarkening * grass[size_t(c)], 0.3f * kGroundDarkening * grass[1]) << c;
   // A different palette gives a different ground: the colours do come from the atlas.
   const TuftAtlas other = makeTuftAtlas(1, 123, 64, 4);
   const auto otherGround = meanLinear(makeGroundTexture(other, 5, 64));
   const auto otherGrass = other.meanColour(0, 0);
-  EXPECT_NEAR(luminance(otherGround), kGroundDarkening * luminance(otherGrass), 0.15f * kGroundDarkening * luminance(otherGrass));
+  EXPECT_NEAR(luminance(otherGround), kGroundDarkening * luminance(otherGrass),
+              0.15f * kGroundDarkening * luminance(otherGrass));
 }
 
 TEST(AtlasPng, WritesAFileStbReadsBackIdentically) {

@@ -14,10 +14,9 @@ using test::slope;
 using test::sphere;
 
 template <class S>
-double d(S v) { return ScalarTraits<S>::toDouble(v); }
-
-
-
+double d(S v) {
+  return ScalarTraits<S>::toDouble(v);
+}
 
 using test::makeTyped;
 
@@ -181,7 +180,8 @@ TEST(Bodies, BoxDoesNotSinkThroughARidgeBetweenItsCorners) {
 // an awake body touching them wakes them; the sleep state is saved like any other state.
 TEST(Bodies, SleepWakeAndRestore) {
   Scenario s = emptyWorld();
-  s.bodies.list = {sphere("resting", Rational{3, 10}, r3(0, 3, 0, 10)), sphere("dropped", Rational{3, 10}, r3(0, 3, 0))};
+  s.bodies.list = {sphere("resting", Rational{3, 10}, r3(0, 3, 0, 10)),
+                   sphere("dropped", Rational{3, 10}, r3(0, 3, 0))};
   s.bodies.list[1].position = r3(1, 3, 0);  // falls next to the first, not on it
   s.script = {ScriptedCommand{200, 0, BodyCommandKind::AddVelocity, r3(1, 0, 0)}};
   auto w = makeTyped<Fx32>(s);
@@ -295,7 +295,8 @@ TEST(Bodies, BroadPhasesAreBitIdentical) {
           EXPECT_GT(contactTicks, 100) << "bodies rest on the ground: contacts most ticks";
           hashes.push_back(w->stateHash());
         }
-      for (size_t i = 1; i < hashes.size(); ++i) EXPECT_EQ(hashes[i], hashes[0]) << file << " " << scalar << " variant " << i;
+      for (size_t i = 1; i < hashes.size(); ++i)
+        EXPECT_EQ(hashes[i], hashes[0]) << file << " " << scalar << " variant " << i;
     }
 }
 

@@ -21,7 +21,9 @@ using test::slope;
 using test::sphere;
 
 template <class S>
-double d(S v) { return ScalarTraits<S>::toDouble(v); }
+double d(S v) {
+  return ScalarTraits<S>::toDouble(v);
+}
 
 constexpr double kG = 9.81;
 constexpr double kDt = 1.0 / 60.0;
@@ -31,8 +33,6 @@ constexpr double kSlop = 0.0005;  // linearSlop of the position pass (world.cpp)
 /// 2.3e-10); the scalar then rounds that fraction once.
 Rational q12(double v) { return *Rational::make(std::llround(v * 1e12), 1000000000000); }
 Rational3 q12(double x, double y, double z) { return {q12(x), q12(y), q12(z)}; }
-
-
 
 /// A cube of edge 0.5 m, mass 1 kg, restitution 0.
 BodySpec cube(const std::string& name, Rational3 position, Rational friction) {
@@ -55,7 +55,6 @@ template <class S>
 void run(World<S>& w, const Scenario& s, int64_t ticks) {
   for (int64_t t = 0; t < ticks; ++t) ASSERT_TRUE(w.step(scriptedInput(s, w.tick())).ok) << "tick " << w.tick();
 }
-
 
 const double kTheta = std::atan(0.25);  // 14.04 deg
 const double kSin = std::sin(kTheta), kCos = std::cos(kTheta);
@@ -96,8 +95,10 @@ void expectNoCreepBelowFrictionAngle(const char* scalar) {
     worstTilt = std::max(worstTilt, std::acos(std::min(1.0, c)));
   }
   const double drift = alongSlope(d(b.position.x()), d(b.position.y())) - s0;
-  std::printf("[creep %s] settle drift %.6f m, drift over 10 s %.6f m (max |.| %.6f), height above plane %.6f..%.6f m, "
-              "max tilt %.3g rad\n", scalar, settleDrift, drift, worst, lo, hi, worstTilt);
+  std::printf(
+      "[creep %s] settle drift %.6f m, drift over 10 s %.6f m (max |.| %.6f), height above plane %.6f..%.6f m, "
+      "max tilt %.3g rad\n",
+      scalar, settleDrift, drift, worst, lo, hi, worstTilt);
   ::testing::Test::RecordProperty(std::string("creep_drift_m_") + scalar, std::to_string(drift));
   ::testing::Test::RecordProperty(std::string("creep_max_drift_m_") + scalar, std::to_string(worst));
   // Static friction holds when mu >= tan(theta): the exact answer is zero drift. The solver is
@@ -113,7 +114,9 @@ void expectNoCreepBelowFrictionAngle(const char* scalar) {
   EXPECT_LT(hi, 0.25 + 0.001) << scalar << ": lifts off";
   EXPECT_LT(worstTilt, 0.01) << scalar << ": the bottom face stays on the plane (0.6 deg)";
 }
-TEST(BodyAccuracy, BoxOnSlopeBelowFrictionAngleDoesNotCreepDouble) { expectNoCreepBelowFrictionAngle<double>("double"); }
+TEST(BodyAccuracy, BoxOnSlopeBelowFrictionAngleDoesNotCreepDouble) {
+  expectNoCreepBelowFrictionAngle<double>("double");
+}
 TEST(BodyAccuracy, BoxOnSlopeBelowFrictionAngleDoesNotCreepFx32) { expectNoCreepBelowFrictionAngle<Fx32>("fx32"); }
 
 // ---- 2. kinetic friction: above the friction angle it slides with g (sin - mu cos) -------------------
@@ -156,10 +159,11 @@ TEST(BodyAccuracy, BoxSlidesDownSlopeWithCoulombAcceleration) {
       resid = std::max(resid, std::fabs(ss[i] - (c0 + c1 * u + c2 * u * u)));
     }
   }
-  const double measured = -2 * c2;  // down the slope is -s
+  const double measured = -2 * c2;                   // down the slope is -s
   const double analytic = kG * (kSin - 0.1 * kCos);  // 1.4276 m/s^2
-  std::printf("[slide] measured a = %.6f m/s^2, analytic g (sin - mu cos) = %.6f m/s^2, ratio %.5f, fit residual %.3g m\n",
-              measured, analytic, measured / analytic, resid);
+  std::printf(
+      "[slide] measured a = %.6f m/s^2, analytic g (sin - mu cos) = %.6f m/s^2, ratio %.5f, fit residual %.3g m\n",
+      measured, analytic, measured / analytic, resid);
   ::testing::Test::RecordProperty("slide_accel_measured", std::to_string(measured));
   ::testing::Test::RecordProperty("slide_accel_analytic", std::to_string(analytic));
   // Semi-implicit Euler under a constant net force gives positions that are exactly quadratic in
@@ -177,12 +181,12 @@ TEST(BodyAccuracy, BoxSlidesDownSlopeWithCoulombAcceleration) {
 
 // ---- 3. a stack of five cubes stands ---------------------------------------------------------------
 struct StackStats {
-  double horizontal = 0;  // largest horizontal distance of a box from where it was placed (m)
+  double horizontal = 0;               // largest horizontal distance of a box from where it was placed (m)
   double topMin = 1e9, topMax = -1e9;  // top box height after the first second (m)
-  double jitter = 0;      // largest (max - min) height of a box over the last 10 s (m)
-  double tilt = 0;        // largest angle of a box's up axis from vertical (rad)
-  double yaw = 0;         // largest rotation of a box about the vertical (rad)
-  int fellAt = -1;        // first tick the top box is 5 cm below its standing height
+  double jitter = 0;                   // largest (max - min) height of a box over the last 10 s (m)
+  double tilt = 0;                     // largest angle of a box's up axis from vertical (rad)
+  double yaw = 0;                      // largest rotation of a box about the vertical (rad)
+  int fellAt = -1;                     // first tick the top box is 5 cm below its standing height
 };
 
 Scenario stackScenario(int velocityIterations, int positionIterations) {
@@ -221,9 +225,10 @@ StackStats runStack(const Scenario& s, int ticks) {
 template <class S>
 void expectStackStands(const std::string& label, int velocityIterations, int positionIterations) {
   const StackStats st = runStack<S>(stackScenario(velocityIterations, positionIterations), 1200);
-  std::printf("[stack %s] horizontal drift %.6f m, top height (after 1 s) %.6f..%.6f m, jitter (last 10 s) %.6f m, "
-              "max tilt %.3g rad, max yaw %.3g rad, top box fell at tick %d\n",
-              label.c_str(), st.horizontal, st.topMin, st.topMax, st.jitter, st.tilt, st.yaw, st.fellAt);
+  std::printf(
+      "[stack %s] horizontal drift %.6f m, top height (after 1 s) %.6f..%.6f m, jitter (last 10 s) %.6f m, "
+      "max tilt %.3g rad, max yaw %.3g rad, top box fell at tick %d\n",
+      label.c_str(), st.horizontal, st.topMin, st.topMax, st.jitter, st.tilt, st.yaw, st.fellAt);
   ::testing::Test::RecordProperty("stack_horizontal_m_" + label, std::to_string(st.horizontal));
   ::testing::Test::RecordProperty("stack_jitter_m_" + label, std::to_string(st.jitter));
   ::testing::Test::RecordProperty("stack_top_min_m_" + label, std::to_string(st.topMin));
@@ -293,9 +298,10 @@ void expectSphereRestsOnBox(const char* scalar) {
     boxHi = std::max(boxHi, d(bb.position.y()));
   }
   const double y10 = d(sb.position.y());
-  std::printf("[sphere-on-box %s] sphere y %.6f at 3 s, %.6f at 10 s (expect 0.7 - slop); over 3..10 s: max off-centre "
-              "%.4f m, max speed %.4f m/s; box y %.6f..%.6f, box up axis x %.2e z %.2e\n",
-              scalar, y3, y10, off, speed, boxLo, boxHi, d(bb.rotation(0, 1)), d(bb.rotation(2, 1)));
+  std::printf(
+      "[sphere-on-box %s] sphere y %.6f at 3 s, %.6f at 10 s (expect 0.7 - slop); over 3..10 s: max off-centre "
+      "%.4f m, max speed %.4f m/s; box y %.6f..%.6f, box up axis x %.2e z %.2e\n",
+      scalar, y3, y10, off, speed, boxLo, boxHi, d(bb.rotation(0, 1)), d(bb.rotation(2, 1)));
   ::testing::Test::RecordProperty(std::string("sphere_on_box_offcentre_m_") + scalar, std::to_string(off));
   ::testing::Test::RecordProperty(std::string("sphere_on_box_speed_ms_") + scalar, std::to_string(speed));
   // On top: centre at box top 0.5 + radius 0.2, minus the slop of both contacts (box-ground and
@@ -321,12 +327,12 @@ TEST(BodyAccuracy, SphereDroppedOnBoxRestsOnTopFx32) { expectSphereRestsOnBox<Fx
 
 // ---- 5. grass recovers after a body leaves ----------------------------------------------------------
 struct Recovery {
-  double vyAtLeave = 0;      // hidden upward particle velocity (m/s) when the body left
-  int bentTufts = 0;         // tufts that reached tilt level >= 1 while the body rolled
+  double vyAtLeave = 0;           // hidden upward particle velocity (m/s) when the body left
+  int bentTufts = 0;              // tufts that reached tilt level >= 1 while the body rolled
   double worstOffsetAtLeave = 0;  // largest tip offset (m) when the body left
-  double firstUpright = -1;  // s after the body left: first tick with every tuft recovered
-  double staysUpright = -1;  // s after the body left: from here on every tuft stays recovered
-  double tiltZero = -1;      // s after the body left: from here on tilt level 0 everywhere
+  double firstUpright = -1;       // s after the body left: first tick with every tuft recovered
+  double staysUpright = -1;       // s after the body left: from here on every tuft stays recovered
+  double tiltZero = -1;           // s after the body left: from here on tilt level 0 everywhere
 };
 
 /// thesis-bodies.json with the bunny (r 0.4 m, 2 kg) alone, rolled through the meadow at 3 m/s
@@ -376,8 +382,10 @@ Recovery measureRecovery(ConstraintMode mode, double horizonSeconds) {
     const bool tilted = std::any_of(p.tiltLevel.begin(), p.tiltLevel.end(), [](uint8_t l) { return l > 0; });
     const bool upright = !tilted && worstOffset() < 0.01;
     if (tilted) lastTilted = t;
-    if (!upright) lastBad = t;
-    else if (r.firstUpright < 0) r.firstUpright = (t + 1) * kDt;
+    if (!upright)
+      lastBad = t;
+    else if (r.firstUpright < 0)
+      r.firstUpright = (t + 1) * kDt;
   }
   // Step t ends (t + 1) dt after the body left; recovered for good from the step after the last
   // bad one. Only known if that is at least 10 s inside the horizon.
@@ -387,10 +395,11 @@ Recovery measureRecovery(ConstraintMode mode, double horizonSeconds) {
 }
 
 void report(const char* name, const Recovery& r) {
-  std::printf("[grass %s] %d tufts bent (tilt >= 1) by the body; when it left: hidden v_y %.3f m/s, worst tip offset "
-              "%.3f m; after it left: first all recovered %.2f s, recovered for good %.2f s, tilt level 0 for good "
-              "%.2f s\n",
-              name, r.bentTufts, r.vyAtLeave, r.worstOffsetAtLeave, r.firstUpright, r.staysUpright, r.tiltZero);
+  std::printf(
+      "[grass %s] %d tufts bent (tilt >= 1) by the body; when it left: hidden v_y %.3f m/s, worst tip offset "
+      "%.3f m; after it left: first all recovered %.2f s, recovered for good %.2f s, tilt level 0 for good "
+      "%.2f s\n",
+      name, r.bentTufts, r.vyAtLeave, r.worstOffsetAtLeave, r.firstUpright, r.staysUpright, r.tiltZero);
   ::testing::Test::RecordProperty(std::string("grass_recovered_s_") + name, std::to_string(r.staysUpright));
   ::testing::Test::RecordProperty(std::string("grass_first_recovered_s_") + name, std::to_string(r.firstUpright));
   ::testing::Test::RecordProperty(std::string("grass_tilt_zero_s_") + name, std::to_string(r.tiltZero));
@@ -451,8 +460,8 @@ TEST(BodyAccuracy, GrassRecoversAfterABodyLeavesPbdMode) {
   const double hi = 1.1 * std::log(std::numbers::pi / kEndAngle) / gamma;
   const double tiltLo = 0.8 * std::log(phiLeave / kTiltAngle) / gamma;
   const double tiltHi = 1.1 * std::log(std::numbers::pi / kTiltAngle) / gamma;
-  std::printf("[grass pbd] model: recovered within %.1f .. %.1f s, tilt level 0 within %.1f .. %.1f s\n", lo, hi, tiltLo,
-              tiltHi);
+  std::printf("[grass pbd] model: recovered within %.1f .. %.1f s, tilt level 0 within %.1f .. %.1f s\n", lo, hi,
+              tiltLo, tiltHi);
   EXPECT_GT(r.staysUpright, lo) << "pbd: settles faster than the damping allows";
   EXPECT_LT(r.staysUpright, hi) << "pbd: settles slower than the damped pendulum";
   EXPECT_GT(r.tiltZero, tiltLo);

@@ -291,10 +291,15 @@ TEST(BodyInputs, BladeSwitchesOnOtherBodiesChangeNothing) {
 
 TickInput spawnAndSwitch(int64_t tick) {
   TickInput in;
-  if (tick == 5) in.bodies = {BodyCommand{1, BodyCommandKind::Spawn, at(2, 1, 1)}, BodyCommand{0, BodyCommandKind::Spawn, at(-2, 2, -1)}};
-  if (tick == 8) in.bodies = {BodyCommand{2, BodyCommandKind::MowerOff, {}}, BodyCommand{1, BodyCommandKind::AddVelocity, at(1, 0, 0)}};
+  if (tick == 5)
+    in.bodies = {BodyCommand{1, BodyCommandKind::Spawn, at(2, 1, 1)},
+                 BodyCommand{0, BodyCommandKind::Spawn, at(-2, 2, -1)}};
+  if (tick == 8)
+    in.bodies = {BodyCommand{2, BodyCommandKind::MowerOff, {}},
+                 BodyCommand{1, BodyCommandKind::AddVelocity, at(1, 0, 0)}};
   if (tick == 12) in.bodies = {BodyCommand{3, BodyCommandKind::AddVelocity, at(0, 2, 0)}};
-  if (tick == 30) in.bodies = {BodyCommand{2, BodyCommandKind::MowerOn, {}}, BodyCommand{1, BodyCommandKind::Reset, {}}};
+  if (tick == 30)
+    in.bodies = {BodyCommand{2, BodyCommandKind::MowerOn, {}}, BodyCommand{1, BodyCommandKind::Reset, {}}};
   return in;
 }
 
@@ -357,7 +362,8 @@ TEST(BodyInputs, BladeSwitchesAndSpawnsLiveInTheirSections) {
   EXPECT_EQ(off[mowerFlags] & 2, 2) << "the mower's record says its blade is off";
   ASSERT_TRUE(w->step(spawnAndSwitch(0)).ok);
   const std::vector<uint8_t> spawned = w->saveState();
-  EXPECT_EQ(loadLE<uint32_t>(spawned.data() + test::findSection(spawned, "SPWN").payloadAt), uint32_t(w->counts().bodies - 2));
+  EXPECT_EQ(loadLE<uint32_t>(spawned.data() + test::findSection(spawned, "SPWN").payloadAt),
+            uint32_t(w->counts().bodies - 2));
 }
 
 TEST(BodyInputs, DamagedBodyInputsGiveAStateErrorNeverACrash) {
@@ -444,8 +450,9 @@ TEST(BodyInputs, ScriptsAndTracksNameTheNewCommands) {
     return std::string("accepted");
   };
   const std::string head = R"({"format": "simgrass-input-track/1", )";
-  EXPECT_NE(error(head + R"("commands": [{"tick": 1, "body": "ball", "command": "spawn"}]})").find("$.commands[0].value"),
-            std::string::npos);
+  EXPECT_NE(
+      error(head + R"("commands": [{"tick": 1, "body": "ball", "command": "spawn"}]})").find("$.commands[0].value"),
+      std::string::npos);
   EXPECT_NE(error(head + R"("commands": [{"tick": 1, "body": 64, "command": "reset"}]})").find("$.commands[0].body"),
             std::string::npos);
   EXPECT_NE(error(head + R"("commands": [{"tick": 1, "body": "ball", "command": "mow"}]})").find("mowerOff"),

@@ -52,10 +52,14 @@ Vector3d toD(const Vec3<S>& v) {
 template <class S>
 double ulpAtOne() {
   switch (ScalarTraits<S>::kind) {
-    case ScalarKind::Fx32: return std::ldexp(1.0, -32);
-    case ScalarKind::Fx16: return std::ldexp(1.0, -16);
-    case ScalarKind::Float: return std::ldexp(1.0, -23);
-    case ScalarKind::Double: break;
+    case ScalarKind::Fx32:
+      return std::ldexp(1.0, -32);
+    case ScalarKind::Fx16:
+      return std::ldexp(1.0, -16);
+    case ScalarKind::Float:
+      return std::ldexp(1.0, -23);
+    case ScalarKind::Double:
+      break;
   }
   return std::ldexp(1.0, -52);
 }
@@ -126,7 +130,8 @@ std::vector<ContactD> collide(const BoxD& a, const BoxD& b, int* count = nullptr
   const int n = collideBoxBox<S>(7, vecS<S>(a.half), poseS<S>(a), 9, vecS<S>(b.half), poseS<S>(b), out);
   if (count) *count = n;
   std::vector<ContactD> r;
-  for (const auto& c : out) r.push_back({c.bodyA, c.bodyB, c.featureA, c.featureB, toD(c.point), toD(c.normal), toD(c.penetration)});
+  for (const auto& c : out)
+    r.push_back({c.bodyA, c.bodyB, c.featureA, c.featureB, toD(c.point), toD(c.normal), toD(c.penetration)});
   return r;
 }
 template <class S>
@@ -184,9 +189,7 @@ const double kR2 = std::numbers::sqrt2;
 
 /// A small box lying face down on a big one, axis aligned; overlap 1/8 m. Every number is a
 /// dyadic rational, exact in all four scalars.
-Config restingAxisAligned() {
-  return {"resting", {{0.5, 0.25, 0.5}, {0.25, 1.125, -0.125}}, {{2, 1, 2}, {0, 0, 0}}};
-}
+Config restingAxisAligned() { return {"resting", {{0.5, 0.25, 0.5}, {0.25, 1.125, -0.125}}, {{2, 1, 2}, {0, 0, 0}}}; }
 /// The same box turned 45 degrees about y (its corners point along x and z in plan view).
 Config restingTurned45() {
   return {"turned45", {{0.5, 0.25, 0.5}, {0.25, 1.125, -0.125}, about(Vector3d::UnitY(), 45)}, {{2, 1, 2}, {0, 0, 0}}};
@@ -197,12 +200,16 @@ Config octagon() {
 }
 /// A cube balanced on its edge (turned 45 degrees about z) on a flat box, sunk 0.05 m.
 Config onEdge() {
-  return {"onEdge", {{0.5, 0.5, 0.5}, {0.1, 1 + 0.5 * kR2 - 0.05, 0.2}, about(Vector3d::UnitZ(), 45)}, {{2, 1, 2}, {0, 0, 0}}};
+  return {"onEdge",
+          {{0.5, 0.5, 0.5}, {0.1, 1 + 0.5 * kR2 - 0.05, 0.2}, about(Vector3d::UnitZ(), 45)},
+          {{2, 1, 2}, {0, 0, 0}}};
 }
 /// Crossed edges: A turned 45 degrees about x (lowest edge along x), B turned 45 degrees about z
 /// (highest edge along z); the edges cross at (0, sqrt2 - 0.05, 0.2), overlap 0.1.
 Config crossed() {
-  return {"crossed", {{1, 1, 1}, {0.3, 2 * kR2 - 0.1, 0.2}, about(Vector3d::UnitX(), 45)}, {{1, 1, 1}, {0, 0, 0}, about(Vector3d::UnitZ(), 45)}};
+  return {"crossed",
+          {{1, 1, 1}, {0.3, 2 * kR2 - 0.1, 0.2}, about(Vector3d::UnitX(), 45)},
+          {{1, 1, 1}, {0, 0, 0}, about(Vector3d::UnitZ(), 45)}};
 }
 /// Crossed edges at 60 degrees: B's top edge is turned 30 degrees about y as well.
 Config crossedSkew() {
@@ -210,7 +217,9 @@ Config crossedSkew() {
           {{1, 1, 1}, {0.3, 2 * kR2 - 0.1, 0.2}, about(Vector3d::UnitX(), 45)},
           {{1, 1, 1}, {0, 0, 0}, about(Vector3d::UnitY(), 30) * about(Vector3d::UnitZ(), 45)}};
 }
-std::vector<Config> touchingConfigs() { return {restingAxisAligned(), restingTurned45(), octagon(), onEdge(), crossed(), crossedSkew()}; }
+std::vector<Config> touchingConfigs() {
+  return {restingAxisAligned(), restingTurned45(), octagon(), onEdge(), crossed(), crossedSkew()};
+}
 
 Config swapped(const Config& c) { return {c.name + "/swapped", c.b, c.a}; }
 
@@ -232,7 +241,9 @@ TYPED_TEST(BoxBoxTyped, SeparatedBoxesGiveNoContacts) {
       // about z, its own faces overlap B.
       {"faceB", {{1, 1, 1}, {0, 0, 0}, about(Vector3d::UnitZ(), 45)}, {{1, 1, 1}, {2.5, 0, 0}}},
       // Only the edge pair separates: crossed() lifted by 0.2 (gap 0.1).
-      {"edge", {{1, 1, 1}, {0.3, 2 * kR2 + 0.1, 0.2}, about(Vector3d::UnitX(), 45)}, {{1, 1, 1}, {0, 0, 0}, about(Vector3d::UnitZ(), 45)}},
+      {"edge",
+       {{1, 1, 1}, {0.3, 2 * kR2 + 0.1, 0.2}, about(Vector3d::UnitX(), 45)},
+       {{1, 1, 1}, {0, 0, 0}, about(Vector3d::UnitZ(), 45)}},
       {"far", unit, {{1, 1, 1}, {50, -40, 30}, about(Vector3d(1, 2, 3), 33)}},
   };
   for (const Config& c : cases) {
@@ -267,8 +278,8 @@ TYPED_TEST(BoxBoxTyped, RestingFaceDownGivesFourCornersExactly) {
     // Dyadic inputs, identity rotations: every step is exact in every scalar.
     EXPECT_EQ(k.normal, Vector3d(0, 1, 0));
     EXPECT_EQ(k.pen, 0.125);
-    EXPECT_EQ(k.point.y(), 0.9375);  // halfway between A's bottom (0.875) and B's top (1)
-    EXPECT_EQ(k.featureA, 3u);       // A's -y face is the reference (tie with B's +y: A wins)
+    EXPECT_EQ(k.point.y(), 0.9375);                      // halfway between A's bottom (0.875) and B's top (1)
+    EXPECT_EQ(k.featureA, 3u);                           // A's -y face is the reference (tie with B's +y: A wins)
     EXPECT_EQ(k.featureB / kBoxIncidentFaceStride, 2u);  // B's +y face is incident
     corners.push_back(k.point);
   }
@@ -339,7 +350,7 @@ TYPED_TEST(BoxBoxTyped, CrossedEdgesGiveOneEdgeContact) {
     const ContactD k = collide<S>(c)[0];
     EXPECT_GE(k.featureA, kBoxEdgeFeature);
     EXPECT_GE(k.featureB, kBoxEdgeFeature);
-    EXPECT_EQ(k.featureA, kBoxEdgeFeature + 2);  // A's edge along x (axis 0) at local -y, +z (code 2)
+    EXPECT_EQ(k.featureA, kBoxEdgeFeature + 2);         // A's edge along x (axis 0) at local -y, +z (code 2)
     EXPECT_EQ((k.featureB - kBoxEdgeFeature) / 4, 2u);  // B's edge along its z axis
     EXPECT_NEAR((k.point - Vector3d(0, kR2 - 0.05, 0.2)).norm(), 0, tol<S>(4));
   }
@@ -445,13 +456,23 @@ TYPED_TEST(BoxBoxTyped, DegenerateCasesStayFinite) {
   const double rangeP = ScalarTraits<S>::kind == ScalarKind::Fx16 ? 100 : 1000;
   std::vector<Config> cases = {
       {"sameBox", {{1, 1, 1}, {0, 0, 0}}, {{1, 1, 1}, {0, 0, 0}}},
-      {"sameCentreTurned", {{1, 0.5, 0.25}, {3, 2, 1}, about(Vector3d(1, 1, 0), 30)}, {{0.5, 2, 1}, {3, 2, 1}, about(Vector3d(0, 1, 1), 70)}},
+      {"sameCentreTurned",
+       {{1, 0.5, 0.25}, {3, 2, 1}, about(Vector3d(1, 1, 0), 30)},
+       {{0.5, 2, 1}, {3, 2, 1}, about(Vector3d(0, 1, 1), 70)}},
       // Both turned 45 degrees about z, A's lowest edge sunk 0.1 into B's highest: parallel edges.
-      {"parallelEdges", {{1, 1, 1}, {0, 2 * kR2 - 0.1, 0}, about(Vector3d::UnitZ(), 45)}, {{1, 1, 1}, {0, 0, 0}, about(Vector3d::UnitZ(), 45)}},
-      {"edgeOnEdge", {{1, 1, 1}, {0, 2 * kR2 - 0.01, 0}, about(Vector3d::UnitZ(), 45)}, {{1, 1, 1}, {0, 0, 0}, about(Vector3d::UnitZ(), 45)}},
+      {"parallelEdges",
+       {{1, 1, 1}, {0, 2 * kR2 - 0.1, 0}, about(Vector3d::UnitZ(), 45)},
+       {{1, 1, 1}, {0, 0, 0}, about(Vector3d::UnitZ(), 45)}},
+      {"edgeOnEdge",
+       {{1, 1, 1}, {0, 2 * kR2 - 0.01, 0}, about(Vector3d::UnitZ(), 45)},
+       {{1, 1, 1}, {0, 0, 0}, about(Vector3d::UnitZ(), 45)}},
       {"cornerOnCorner", {{1, 1, 1}, {1.99, 1.99, 1.99}}, {{1, 1, 1}, {0, 0, 0}}},
-      {"tinyOnHuge", {{0.005, 0.005, 0.005}, {rangeP - 1, 50.004, rangeP - 1}, about(Vector3d(1, 3, 2), 10)}, {{50, 50, 50}, {rangeP - 1, 0, rangeP - 1}}},
-      {"hugeOnHuge", {{50, 50, 50}, {-rangeP, 99.5, -rangeP}, about(Vector3d(1, 1, 1), 1)}, {{50, 50, 50}, {-rangeP, 0, -rangeP}}},
+      {"tinyOnHuge",
+       {{0.005, 0.005, 0.005}, {rangeP - 1, 50.004, rangeP - 1}, about(Vector3d(1, 3, 2), 10)},
+       {{50, 50, 50}, {rangeP - 1, 0, rangeP - 1}}},
+      {"hugeOnHuge",
+       {{50, 50, 50}, {-rangeP, 99.5, -rangeP}, about(Vector3d(1, 1, 1), 1)},
+       {{50, 50, 50}, {-rangeP, 0, -rangeP}}},
       {"almostParallel", {{1, 1, 1}, {0, 1.99, 0}, about(Vector3d(1, 0, 1), 1e-4)}, {{1, 1, 1}, {0, 0, 0}}},
   };
   for (const Config& base : cases)

@@ -60,8 +60,8 @@ struct CliResult {
   int exitCode = -1;  ///< exit status, or 128 + signal when it was killed
   std::string out, err;
   std::string describe() const {
-    return "exit code " + std::to_string(exitCode) + "\n--- stdout ---\n" + out.substr(0, 2000) +
-           "\n--- stderr ---\n" + err.substr(0, 2000);
+    return "exit code " + std::to_string(exitCode) + "\n--- stdout ---\n" + out.substr(0, 2000) + "\n--- stderr ---\n" +
+           err.substr(0, 2000);
   }
 };
 
@@ -70,8 +70,8 @@ struct CliResult {
 inline CliResult runCli(const std::string& args) {
   TempDir dir;
   const std::string out = dir.file("stdout"), err = dir.file("stderr");
-  const std::string cmd = "timeout -k 5 60 " + quote(SIMGRASS_CLI) + " " + args + " </dev/null >" + quote(out) +
-                          " 2>" + quote(err);
+  const std::string cmd =
+      "timeout -k 5 60 " + quote(SIMGRASS_CLI) + " " + args + " </dev/null >" + quote(out) + " 2>" + quote(err);
   const int status = std::system(cmd.c_str());
   CliResult r;
   if (status == -1) {

@@ -37,7 +37,8 @@ const std::vector<GoldenCase> kGoldenCases = [] {
 /// A test name from a golden case ("thesis_meadow_fx32").
 std::string caseName(const GoldenCase& c) {
   std::string n = c.scenario + "_" + c.scalar;
-  for (char& ch : n) if (ch == '-') ch = '_';
+  for (char& ch : n)
+    if (ch == '-') ch = '_';
   return n;
 }
 
@@ -77,12 +78,12 @@ TEST_P(GoldenHash, MatchesCommittedHashAfter600Ticks) {
       << " threads. If the physics was meant to change, run .ci/update-goldens and say why in the commit.";
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    ScenariosScalarsThreads, GoldenHash,
-    ::testing::Combine(::testing::ValuesIn(kGoldenCases), ::testing::Values(1, 2, 4)),
-    [](const auto& info) {
-      return caseName(std::get<0>(info.param)) + "_threads" + std::to_string(std::get<1>(info.param));
-    });
+INSTANTIATE_TEST_SUITE_P(ScenariosScalarsThreads, GoldenHash,
+                         ::testing::Combine(::testing::ValuesIn(kGoldenCases), ::testing::Values(1, 2, 4)),
+                         [](const auto& info) {
+                           return caseName(std::get<0>(info.param)) + "_threads" +
+                                  std::to_string(std::get<1>(info.param));
+                         });
 
 // The scalar reference kernel must reach the same goldens (the default is the AVX2 kernel on
 // CPUs that have it; tests/particle_kernel_test.cpp compares the two tick by tick).
@@ -97,8 +98,8 @@ TEST_P(GoldenHashScalarKernel, MatchesCommittedHashAfter600Ticks) {
   EXPECT_EQ(hex(w->stateHash()), g.at(c.scenario + "/" + c.scalar).get<std::string>()) << c.scenario << " " << c.scalar;
 }
 
-INSTANTIATE_TEST_SUITE_P(Goldens, GoldenHashScalarKernel,
-                         ::testing::ValuesIn(kGoldenCases), [](const auto& info) { return caseName(info.param); });
+INSTANTIATE_TEST_SUITE_P(Goldens, GoldenHashScalarKernel, ::testing::ValuesIn(kGoldenCases),
+                         [](const auto& info) { return caseName(info.param); });
 
 class SaveRestore : public ::testing::TestWithParam<GoldenCase> {};
 
@@ -118,8 +119,8 @@ TEST_P(SaveRestore, RestoreAtTick300ContinuesToTheGoldenHash) {
   EXPECT_EQ(hex(fresh->stateHash()), g.at(c.scenario + "/" + c.scalar).get<std::string>());
 }
 
-INSTANTIATE_TEST_SUITE_P(Goldens, SaveRestore,
-                         ::testing::ValuesIn(kGoldenCases), [](const auto& info) { return caseName(info.param); });
+INSTANTIATE_TEST_SUITE_P(Goldens, SaveRestore, ::testing::ValuesIn(kGoldenCases),
+                         [](const auto& info) { return caseName(info.param); });
 
 // float and double promise only same-binary reproducibility, but for any thread count.
 TEST(FloatDeterminism, SameHashForOneTwoAndFourThreads) {
@@ -198,7 +199,9 @@ TEST_F(BadState, AVersionOneStateNamesItsVersion) {
   b[7] = '1';
   expectError(b, 7, "version 2");
 }
-TEST_F(BadState, TruncatedHeadSection) { expectError({good.begin(), good.begin() + 30}, 12, "length for section 'HEAD'"); }
+TEST_F(BadState, TruncatedHeadSection) {
+  expectError({good.begin(), good.begin() + 30}, 12, "length for section 'HEAD'");
+}
 TEST_F(BadState, WrongVersion) {
   auto b = good;
   b[20] = 99;

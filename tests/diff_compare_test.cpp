@@ -184,7 +184,8 @@ TEST(Divergence, ZeroDivergenceIsAUniformImage) {
   const int x0 = (img.w - 151 * scale) / 2;
   for (int y = 0; y < 151 * scale; y += 7)
     for (int x = x0; x < x0 + 151 * scale; x += 7)
-      ASSERT_EQ(std::vector<uint8_t>(img.at(x, y), img.at(x, y) + 3), std::vector<uint8_t>(img.at(x0, 0), img.at(x0, 0) + 3))
+      ASSERT_EQ(std::vector<uint8_t>(img.at(x, y), img.at(x, y) + 3),
+                std::vector<uint8_t>(img.at(x0, 0), img.at(x0, 0) + 3))
           << "pixel " << x << ", " << y;
 }
 
@@ -221,7 +222,9 @@ TEST(CompareLockStep, TimeStepsLineUpOnlyByWholeRatios) {
 
 TEST(CompareLockStep, MergedInputsKeepCommandsInOrderAndTheLastCamera) {
   sgr::Recording rec;
-  auto command = [](int32_t body, int64_t x) { return BodyCommand{body, BodyCommandKind::AddVelocity, InputVec3{x, 0, 0}}; };
+  auto command = [](int32_t body, int64_t x) {
+    return BodyCommand{body, BodyCommandKind::AddVelocity, InputVec3{x, 0, 0}};
+  };
   sgr::InputRecord t1, t2;
   t1.tick = 1;
   t1.input.hasCamera = true;
@@ -273,8 +276,8 @@ std::string record(const TempDir& dir, const std::string& name, const std::strin
   const std::string scenarioPath = dir.path() / scenario;
   if (!fs::exists(scenarioPath)) dir.write(scenario, kSmallScenario);
   const std::string out = dir.file(name);
-  const CliResult r = runCli("record " + quote(scenarioPath) + " -o " + quote(out) + " --ticks " + std::to_string(ticks) +
-                             (variant.empty() ? "" : " --variant " + quote(variant)));
+  const CliResult r = runCli("record " + quote(scenarioPath) + " -o " + quote(out) + " --ticks " +
+                             std::to_string(ticks) + (variant.empty() ? "" : " --variant " + quote(variant)));
   EXPECT_EQ(r.exitCode, 0) << r.describe();
   return out;
 }
@@ -358,13 +361,15 @@ TEST(DiffCli, TimeStepsLineUpOrAreRefused) {
   const CliResult bad = runCli("diff " + quote(a) + " " + quote(c));
   EXPECT_EQ(bad.exitCode, 2) << bad.describe();
   EXPECT_TRUE(isOneLine(bad.err));
-  EXPECT_NE(bad.err.find("90.sgr: expected a time step that is a whole multiple or fraction"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("90.sgr: expected a time step that is a whole multiple or fraction"), std::string::npos)
+      << bad.err;
 }
 
 TEST(DiffCli, BadInputIsOneLine) {
   TempDir dir;
   const std::string a = record(dir, "a.sgr", "", 4);
-  dir.write("wide.json", std::string(kSmallScenario).replace(std::string(kSmallScenario).find("\"patchesX\": 31"), 14, "\"patchesX\": 33"));
+  dir.write("wide.json", std::string(kSmallScenario)
+                             .replace(std::string(kSmallScenario).find("\"patchesX\": 31"), 14, "\"patchesX\": 33"));
   const std::string wide = record(dir, "wide.sgr", "", 4, "wide.json");
   dir.write("junk.sgr", "not a recording");
   const std::vector<std::pair<std::string, std::string>> cases = {
@@ -373,7 +378,8 @@ TEST(DiffCli, BadInputIsOneLine) {
       {"diff " + quote(a) + " " + quote(dir.file("missing.sgr")), "missing.sgr"},
       {"diff " + quote(a) + " " + quote(a) + " --heatmap " + quote(dir.file("h.png")) + " --heatmap-tick 5",
        "--heatmap-tick 5: expected 'last', 'max' or a tick from 0 to 4"},
-      {"diff " + quote(a) + " " + quote(a) + " --csv " + quote(dir.file("no/such/folder.csv")), "folder.csv: expected a CSV file"},
+      {"diff " + quote(a) + " " + quote(a) + " --csv " + quote(dir.file("no/such/folder.csv")),
+       "folder.csv: expected a CSV file"},
   };
   for (const auto& [args, expected] : cases) {
     const CliResult r = runCli(args);
@@ -410,9 +416,11 @@ TEST(CompareCli, BroadPhasesAndThreadsAreIdentical) {
 TEST(CompareCli, StateChangingVariantsReportFiniteErrors) {
   TempDir dir;
   const std::string run = record(dir, "run.sgr");
-  const CliResult r = runCli("compare " + quote(run) +
-                             " --variant scalar=fx16 --variant dt=1/120 --variant dt=1/30 --variant scalar=fx16,interp=2 --json"
-                             " --csv " + quote(dir.file("c.csv")) + " --series " + quote(dir.file("s.csv")));
+  const CliResult r =
+      runCli("compare " + quote(run) +
+             " --variant scalar=fx16 --variant dt=1/120 --variant dt=1/30 --variant scalar=fx16,interp=2 --json"
+             " --csv " +
+             quote(dir.file("c.csv")) + " --series " + quote(dir.file("s.csv")));
   ASSERT_EQ(r.exitCode, 0) << r.describe();
   const json j = parseJson(r);
   ASSERT_EQ(j["variants"].size(), 4u);
@@ -440,7 +448,8 @@ TEST(CompareCli, StateChangingVariantsReportFiniteErrors) {
   EXPECT_EQ(csv[1].substr(0, 10), "reference,");
   EXPECT_EQ(csv[5].substr(0, 21), "scalar=fx16 interp=2,");
   const std::vector<std::string> series = lines(readFile(dir.file("s.csv")));
-  EXPECT_EQ(series[0], "variant,tick,tip_max_m,tip_rms_m,body_pos_max_m,body_angle_max_rad,contacts_a,contacts_b,identical");
+  EXPECT_EQ(series[0],
+            "variant,tick,tip_max_m,tip_rms_m,body_pos_max_m,body_angle_max_rad,contacts_a,contacts_b,identical");
   EXPECT_EQ(series.size(), size_t(1 + 3 * (cliTicks() + 1) + cliTicks() / 2 + 1));
 
   const CliResult text = runCli("compare " + quote(run) + " --variant interp=2 --ticks 10");

@@ -51,8 +51,8 @@ template <class A, class B>
   for (Eigen::Index i = 0; i < ea.rows(); ++i)
     for (Eigen::Index j = 0; j < ea.cols(); ++j)
       if (ea(i, j) != eb(i, j))
-        return ::testing::AssertionFailure() << "(" << i << "," << j << "): raw " << int64_t(ea(i, j).raw()) << " vs "
-                                             << int64_t(eb(i, j).raw());
+        return ::testing::AssertionFailure()
+               << "(" << i << "," << j << "): raw " << int64_t(ea(i, j).raw()) << " vs " << int64_t(eb(i, j).raw());
   return ::testing::AssertionSuccess();
 }
 
@@ -280,8 +280,8 @@ TYPED_TEST(EigenFixed, InverseOfWellConditionedMatrix) {
   };
   for (int i = 0; i < 5000; ++i) check(wellConditioned<Fx>(g), i);
   sg::Mat3<Fx> m;  // exact binary fractions
-  m << Fx(2), Fx(1) / Fx(2), Fx(1) / Fx(4), Fx(1) / Fx(8), Fx(3) / Fx(2), Fx(-1) / Fx(2), Fx(3) / Fx(4),
-      Fx(-1) / Fx(4), Fx(3);
+  m << Fx(2), Fx(1) / Fx(2), Fx(1) / Fx(4), Fx(1) / Fx(8), Fx(3) / Fx(2), Fx(-1) / Fx(2), Fx(3) / Fx(4), Fx(-1) / Fx(4),
+      Fx(3);
   check(m, -1);
   // The inverse of a diagonal matrix of powers of two is exact.
   sg::Mat3<Fx> d = sg::Mat3<Fx>::Zero();
@@ -434,7 +434,7 @@ TYPED_TEST(EigenFixed, IsApproxUsesANonZeroPrecision) {
   EXPECT_EQ(NT::lowest(), Fx::min());
   const V v(Fx(1), Fx(2), Fx(3));
   const V near = v + V(Fx::epsilon(), -Fx::epsilon(), Fx(0));  // one ulp: far below 2^(F/2) ulps
-  const V far = v * (Fx(1) + Fx(1) / Fx(100));                  // 1 % off: far above 2^-8
+  const V far = v * (Fx(1) + Fx(1) / Fx(100));                 // 1 % off: far above 2^-8
   EXPECT_TRUE(v.isApprox(v));
   EXPECT_TRUE(v.isApprox(near));
   EXPECT_TRUE(near.isApprox(v));

@@ -125,9 +125,24 @@ std::vector<typename Fx::RawType> edgeRaws() {
   using Raw = typename Fx::RawType;
   constexpr Raw kMax = std::numeric_limits<Raw>::max(), kMin = std::numeric_limits<Raw>::min();
   constexpr Raw one = Fx::kOneRaw, half = one / 2;
-  std::vector<Raw> v = {0,        1,        2,         3,          half - 1, half, half + 1, one - 1,
-                        one,      one + 1,  3 * half,  2 * one,    3 * one,  kMax, kMax - 1, Raw(kMax / 2),
-                        Raw(kMax >> (Fx::kFracBits / 2)), Raw(Raw(1) << (sizeof(Raw) * 8 - 2))};
+  std::vector<Raw> v = {0,
+                        1,
+                        2,
+                        3,
+                        half - 1,
+                        half,
+                        half + 1,
+                        one - 1,
+                        one,
+                        one + 1,
+                        3 * half,
+                        2 * one,
+                        3 * one,
+                        kMax,
+                        kMax - 1,
+                        Raw(kMax / 2),
+                        Raw(kMax >> (Fx::kFracBits / 2)),
+                        Raw(Raw(1) << (sizeof(Raw) * 8 - 2))};
   const size_t n = v.size();
   for (size_t i = 0; i < n; ++i) v.push_back(Raw(-v[i]));  // includes -max
   v.push_back(kMin);
@@ -197,7 +212,7 @@ TEST_F(FixedMul, HalfUlpTiesRoundAwayFromZero) {
   EXPECT_EQ((-Fx32::epsilon() * half).raw(), -1);  // -0.5 ulp -> -1
   EXPECT_EQ((Fx32::fromRaw(3) * half).raw(), 2);   // 1.5 ulp -> 2
   EXPECT_EQ((Fx32::fromRaw(-3) * half).raw(), -2);
-  EXPECT_EQ((Fx32::fromRaw(5) * half).raw(), 3);   // 2.5 -> 3 (not banker's 2)
+  EXPECT_EQ((Fx32::fromRaw(5) * half).raw(), 3);  // 2.5 -> 3 (not banker's 2)
   EXPECT_EQ((Fx32::fromRaw(-5) * half).raw(), -3);
   EXPECT_EQ((Fx32::epsilon() * quarter).raw(), 0);  // 0.25 ulp -> 0
   EXPECT_EQ((Fx32::epsilon() * threeQuarters).raw(), 1);
@@ -350,8 +365,7 @@ void oddSymmetry(uint64_t seed) {
     const Fx qn = (-a) / b;
     const Fx qd = a / (-b);
     if (qOk)
-      div.check(qn == -q && qd == -q,
-                [&] { return "raw " + str(I128(a.raw())) + " / raw " + str(I128(b.raw())); });
+      div.check(qn == -q && qd == -q, [&] { return "raw " + str(I128(a.raw())) + " / raw " + str(I128(b.raw())); });
   }
   EXPECT_TRUE(mul.result()) << "(-a) * b == -(a * b)";
   EXPECT_TRUE(div.result()) << "(-a) / b == -(a / b) == a / (-b)";
@@ -382,16 +396,24 @@ void overflowCases() {
   expectFault([&] { (void)(Fx(1000) / eps); }, kO, "1000 / eps");
   expectFault([&] { (void)(Fx(-1) / eps); }, kO, "-1 / eps = -2^F");
   // -1 / (3 ulps) = -2^(2F) / 3 ulps: -6148914691236517205.3 (Q32.32), -1431655765.3 (Q16.16): fits.
-  expectFault([&] { EXPECT_EQ(int64_t((Fx(-1) / Fx::fromRaw(3)).raw()),
-                              Fx::kFracBits == 32 ? int64_t(-6148914691236517205) : int64_t(-1431655765)); },
-              0, "-1 / 3 ulps");
+  expectFault(
+      [&] {
+        EXPECT_EQ(int64_t((Fx(-1) / Fx::fromRaw(3)).raw()),
+                  Fx::kFracBits == 32 ? int64_t(-6148914691236517205) : int64_t(-1431655765));
+      },
+      0, "-1 / 3 ulps");
   // 2^(F/2 - 1) * 2^(F/2) = 2^(F - 1) in value: one ulp past max (2^31 - u for Q32.32, 2^15 - u
   // for Q16.16); with the second factor one ulp smaller the product is 2^(F-1) - 2^(F/2-1) u: fits.
   const Raw big = static_cast<Raw>(Raw(1) << (Fx::kFracBits + Fx::kFracBits / 2 - 1));
   expectFault([&] { (void)(Fx::fromRaw(big) * Fx::fromRaw(Raw(big * 2))); }, kO, "2^(F/2-1) * 2^(F/2)");
   expectFault([&] { (void)(Fx::fromRaw(big) * Fx::fromRaw(Raw(big * 2 - 1))); }, 0, "just below max");
   expectFault([&] { (void)Fx::mulDiv(mx, Fx(2), Fx(1)); }, kO, "mulDiv(max, 2, 1)");
-  expectFault([&] { Fx c = mx; c += eps; }, kO, "+=");
+  expectFault(
+      [&] {
+        Fx c = mx;
+        c += eps;
+      },
+      kO, "+=");
   // In range: must NOT raise anything.
   expectFault([&] { EXPECT_EQ((mx - eps).raw(), std::numeric_limits<Raw>::max() - 1); }, 0, "max - eps");
   expectFault([&] { EXPECT_EQ((mn + eps).raw(), std::numeric_limits<Raw>::min() + 1); }, 0, "min + eps");
@@ -466,14 +488,14 @@ TEST_F(FixedFault, InRangeBatchRaisesNothing) {
     Fx32 c = Fx32::fromRaw(typicalRaw<Fx32>(g));
     if (sg::abs(c) < Fx32::fromRaw(Fx32::kOneRaw / 128)) c = Fx32(1);
     // Sum < 1e4 + 1.28e4 + 100 + 10 + 174 + 3334 < 2^15: fits Q16.16 as well.
-    const Fx32 r32 = a * b + a / c - b + sg::sqrt(sg::abs(a)) + sg::length3(a, b, c) +
-                     Fx32::mulDiv(a, b, sg::abs(c) + Fx32(3));
+    const Fx32 r32 =
+        a * b + a / c - b + sg::sqrt(sg::abs(a)) + sg::length3(a, b, c) + Fx32::mulDiv(a, b, sg::abs(c) + Fx32(3));
     sink32 += r32.raw();
     const Fx16 x = Fx16::fromRaw(typicalRaw<Fx16>(g)), y = Fx16::fromRaw(typicalRaw<Fx16>(g));
     Fx16 z = Fx16::fromRaw(typicalRaw<Fx16>(g));
     if (sg::abs(z) < Fx16::fromRaw(Fx16::kOneRaw / 128)) z = Fx16(1);
-    const Fx16 r16 = x * y + x / z - y + sg::sqrt(sg::abs(x)) + sg::length3(x, y, z) +
-                     Fx16::mulDiv(x, y, sg::abs(z) + Fx16(3));
+    const Fx16 r16 =
+        x * y + x / z - y + sg::sqrt(sg::abs(x)) + sg::length3(x, y, z) + Fx16::mulDiv(x, y, sg::abs(z) + Fx16(3));
     sink16 += r16.raw() & 0xff;
   }
   EXPECT_EQ(sg::takeFixedFaults(), 0u) << "sink " << sink32 << " " << sink16;
@@ -626,10 +648,10 @@ TEST_F(FixedIsqrt, FloorAndNearestOverAll128BitInputs) {
   for (int i = 0; i < 50000; ++i) check(rand128());                  // mostly near the top
   for (U128 n = 0; n < 20000; ++n) check(n);
   for (U128 k = 0; k < 2000; ++k) {
-    check(kAll - k);                         // near 2^128 - 1
-    check(U128(kR) * kR + k);                // around (2^64 - 1)^2
+    check(kAll - k);           // near 2^128 - 1
+    check(U128(kR) * kR + k);  // around (2^64 - 1)^2
     check(U128(kR) * kR - k);
-    check((U128(1) << 104) + k);             // the estimate's switch-over point
+    check((U128(1) << 104) + k);  // the estimate's switch-over point
     check((U128(1) << 104) - k);
     check((U128(1) << 64) + k);
     check((U128(1) << 64) - k);
@@ -661,10 +683,10 @@ TEST_F(FixedIsqrt, FloorAndNearestOverAll128BitInputs) {
   EXPECT_EQ(sg::isqrtFloor((U128(1) << 64) - 1), (uint64_t(1) << 32) - 1);
   EXPECT_EQ(sg::isqrtFloor(0), 0u);
   EXPECT_EQ(sg::isqrtFloor(3), 1u);
-  EXPECT_EQ(sg::isqrtNearest(2), 1u);   // 1.414
-  EXPECT_EQ(sg::isqrtNearest(3), 2u);   // 1.732
-  EXPECT_EQ(sg::isqrtNearest(6), 2u);   // 2.449
-  EXPECT_EQ(sg::isqrtNearest(7), 3u);   // 2.646
+  EXPECT_EQ(sg::isqrtNearest(2), 1u);  // 1.414
+  EXPECT_EQ(sg::isqrtNearest(3), 2u);  // 1.732
+  EXPECT_EQ(sg::isqrtNearest(6), 2u);  // 2.449
+  EXPECT_EQ(sg::isqrtNearest(7), 3u);  // 2.646
   EXPECT_EQ(sg::isqrtNearest(nearestLimit), kR);
 }
 
@@ -689,8 +711,8 @@ void length3Samples(uint64_t seed) {
     const U128 r = U128(U(got));
     const bool over = r > U128(std::numeric_limits<Raw>::max());
     m.check(isNearestRoot(s, r) && faults == (over ? uint32_t(sg::kFixedFaultOverflow) : 0u), [&] {
-      return "length3(raw " + str(I128(x)) + ", " + str(I128(y)) + ", " + str(I128(z)) + ") = raw " +
-             str(I128(got)) + " faults " + std::to_string(faults);
+      return "length3(raw " + str(I128(x)) + ", " + str(I128(y)) + ", " + str(I128(z)) + ") = raw " + str(I128(got)) +
+             " faults " + std::to_string(faults);
     });
   };
   for (int i = 0; i < 100000; ++i) check(typicalRaw<Fx>(g), typicalRaw<Fx>(g), typicalRaw<Fx>(g));
@@ -784,9 +806,12 @@ void conversionSamples(uint64_t seed) {
     const int64_t want = refFromDouble<Fx>(v);
     sg::takeFixedFaults();
     const Raw got = Fx::fromDouble(v).raw();
-    fromD.check(int64_t(got) == want && sg::takeFixedFaults() == 0,
-                [&] { std::ostringstream o; o.precision(17); o << "fromDouble(" << v << ") want raw " << want
-                      << " got " << int64_t(got); return o.str(); });
+    fromD.check(int64_t(got) == want && sg::takeFixedFaults() == 0, [&] {
+      std::ostringstream o;
+      o.precision(17);
+      o << "fromDouble(" << v << ") want raw " << want << " got " << int64_t(got);
+      return o.str();
+    });
   }
   EXPECT_TRUE(ints.result()) << "Fx(int)";
   EXPECT_TRUE(toD.result()) << "toDouble";
@@ -805,8 +830,8 @@ TEST_F(FixedConversion, FromDoubleTiesAndOverflow) {
   EXPECT_EQ(Fx32::fromDouble(std::ldexp(0.49999999999999994, -32)).raw(), 0);  // just below the tie
   EXPECT_EQ(Fx16::fromDouble(std::ldexp(1.5, -16)).raw(), 2);
   EXPECT_EQ(Fx16::fromDouble(std::ldexp(-1.5, -16)).raw(), -2);
-  EXPECT_EQ(Fx16::fromDouble(0.1).raw(), 6554);        // 6553.6
-  EXPECT_EQ(Fx32::fromDouble(0.1).raw(), 429496730);   // 429496729.6 (0.1 as a double is 0.1000000000000000055)
+  EXPECT_EQ(Fx16::fromDouble(0.1).raw(), 6554);           // 6553.6
+  EXPECT_EQ(Fx32::fromDouble(0.1).raw(), 429496730);      // 429496729.6 (0.1 as a double is 0.1000000000000000055)
   EXPECT_EQ(Fx32::fromDouble(-0.97).raw(), -4166118277);  // 4166118277.12
   EXPECT_EQ(sg::takeFixedFaults(), 0u);
   // Out of range raises overflow and saturates.
@@ -920,9 +945,15 @@ void comparisons(uint64_t seed) {
     const Raw ra = (i & 1) ? fullRaw<Fx>(g) : typicalRaw<Fx>(g, 3);
     Raw rb;
     switch (i % 3) {
-      case 0: rb = fullRaw<Fx>(g); break;
-      case 1: rb = typicalRaw<Fx>(g, 3); break;
-      default: rb = static_cast<Raw>(U(ra) + U(g() & 1)); break;  // equal or one ulp apart
+      case 0:
+        rb = fullRaw<Fx>(g);
+        break;
+      case 1:
+        rb = typicalRaw<Fx>(g, 3);
+        break;
+      default:
+        rb = static_cast<Raw>(U(ra) + U(g() & 1));
+        break;  // equal or one ulp apart
     }
     const Fx a = Fx::fromRaw(ra), b = Fx::fromRaw(rb);
     const auto x = a.raw(), y = b.raw();

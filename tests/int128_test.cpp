@@ -100,8 +100,10 @@ rc::Gen<W128> genW128() {
 W128 drawW128(std::mt19937_64& g) {
   static const std::vector<W128> kEdges = edgeValues();
   switch (g() % 4) {
-    case 0: return W128{g(), g()};
-    case 1: return W128::of(kEdges[g() % kEdges.size()].u() + U128(I128(int(g() % 7) - 3)));
+    case 0:
+      return W128{g(), g()};
+    case 1:
+      return W128::of(kEdges[g() % kEdges.size()].u() + U128(I128(int(g() % 7) - 3)));
     case 2: {
       const U128 v = (U128(1) << (g() % 128)) + U128(I128(int(g() % 3) - 1));
       return W128::of(g() & 1 ? U128(0) - v : v);
@@ -133,14 +135,14 @@ void checkManyCases(Property property) {
     FAIL() << message.str();
   }
 }
-#define INT128_PROP(Suite, Name)                                \
-  void Suite##_##Name##_property();                             \
+#define INT128_PROP(Suite, Name)                                    \
+  void Suite##_##Name##_property();                                 \
   TEST(Suite, Name) { checkManyCases(&Suite##_##Name##_property); } \
   void Suite##_##Name##_property()
 
-#define SAME(got, want, what)                                                                            \
-  do {                                                                                                   \
-    const U128 got_ = U128(got), want_ = U128(want);                                                     \
+#define SAME(got, want, what)                                                                              \
+  do {                                                                                                     \
+    const U128 got_ = U128(got), want_ = U128(want);                                                       \
     if (got_ != want_) RC_FAIL(std::string(what) + ": portable " + hex(got_) + ", builtin " + hex(want_)); \
   } while (0)
 
@@ -292,8 +294,8 @@ TEST(Int128Portable, CheckedArithmeticAtTheLimits) {
   // exactly 2^127 fits when negative only.
   const I128 kMax = std::numeric_limits<I128>::max(), kMin = std::numeric_limits<I128>::min();
   const I128 k63 = I128(1) << 63, k64 = I128(1) << 64;
-  const std::pair<I128, I128> kPairs[] = {{-k64, k63}, {k64, k63},  {k64, -k63}, {-k64, -k63}, {kMin, 1},
-                                          {kMin, -1},  {-1, kMin},  {kMax, 1},   {kMax, -1},   {kMax, 2},
+  const std::pair<I128, I128> kPairs[] = {{-k64, k63}, {k64, k63},   {k64, -k63}, {-k64, -k63},    {kMin, 1},
+                                          {kMin, -1},  {-1, kMin},   {kMax, 1},   {kMax, -1},      {kMax, 2},
                                           {kMin, 0},   {kMax, kMin}, {k63, k63},  {-k63, k63 * 2}, {kMin, kMin}};
   for (const auto& [a, b] : kPairs) {
     I128 want;
@@ -402,7 +404,8 @@ TEST(Int128Sweep, EveryOperationOnAFixedSeedSample) {
     const int n = int(g() % 128);
     check(fromPU(pa * pb) == a.u() * b.u(), "*", a, b);
     check(fromPU(pa + pb) == a.u() + b.u() && fromPU(pa - pb) == a.u() - b.u(), "+-", a, b);
-    check(fromPU(pa << n) == a.u() << n && fromPU(pa >> n) == a.u() >> n && fromP(sa >> n) == a.s() >> n, "shift", a, b);
+    check(fromPU(pa << n) == a.u() << n && fromPU(pa >> n) == a.u() >> n && fromP(sa >> n) == a.s() >> n, "shift", a,
+          b);
     check((pa < pb) == (a.u() < b.u()) && (sa < sb) == (a.s() < b.s()), "<", a, b);
     if (b.u() != 0) {
       check(fromPU(pa / pb) == a.u() / b.u() && fromPU(pa % pb) == a.u() % b.u(), "u / %", a, b);
@@ -482,14 +485,16 @@ TEST(Int128Fixed, Fx32SweepOnAFixedSeedSample) {
   std::mt19937_64 g(3232);
   auto raw = [&g]() -> int64_t {
     switch (g() % 3) {
-      case 0: return int64_t(g());
+      case 0:
+        return int64_t(g());
       case 1: {
         const int len = int(g() % 65);
         const uint64_t v = len == 0 ? 0 : (g() >> (64 - len)) | (uint64_t(1) << (len - 1));
         return int64_t(g() & 1 ? uint64_t(0) - v : v);
       }
       default: {
-        constexpr int64_t kEdges[] = {0, 1, -1, int64_t(1) << 32, -(int64_t(1) << 32), INT64_MAX, INT64_MIN, INT64_MIN + 1};
+        constexpr int64_t kEdges[] = {0,         1,         -1,           int64_t(1) << 32, -(int64_t(1) << 32),
+                                      INT64_MAX, INT64_MIN, INT64_MIN + 1};
         return kEdges[g() % 8];
       }
     }
@@ -500,11 +505,12 @@ TEST(Int128Fixed, Fx32SweepOnAFixedSeedSample) {
     const int64_t a = raw(), b = raw(), c = raw();
     const Fx32 x = Fx32::fromRaw(a), y = Fx32::fromRaw(b), z = Fx32::fromRaw(c);
     const PFx32 px = PFx32::fromRaw(a), py = PFx32::fromRaw(b), pz = PFx32::fromRaw(c);
-    const bool ok = withFaults([&] { return px * py; }) == withFaults([&] { return x * y; }) &&
-                    withFaults([&] { return px / py; }) == withFaults([&] { return x / y; }) &&
-                    withFaults([&] { return PFx32::mulDiv(px, py, pz); }) == withFaults([&] { return Fx32::mulDiv(x, y, z); }) &&
-                    withFaults([&] { return sg::sqrt(px); }) == withFaults([&] { return sg::sqrt(x); }) &&
-                    withFaults([&] { return sg::length3(px, py, pz); }) == withFaults([&] { return sg::length3(x, y, z); });
+    const bool ok =
+        withFaults([&] { return px * py; }) == withFaults([&] { return x * y; }) &&
+        withFaults([&] { return px / py; }) == withFaults([&] { return x / y; }) &&
+        withFaults([&] { return PFx32::mulDiv(px, py, pz); }) == withFaults([&] { return Fx32::mulDiv(x, y, z); }) &&
+        withFaults([&] { return sg::sqrt(px); }) == withFaults([&] { return sg::sqrt(x); }) &&
+        withFaults([&] { return sg::length3(px, py, pz); }) == withFaults([&] { return sg::length3(x, y, z); });
     if (!ok && mismatches++ < 5)
       first += "\n  raws " + std::to_string(a) + ", " + std::to_string(b) + ", " + std::to_string(c);
   }

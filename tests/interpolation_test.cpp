@@ -12,7 +12,9 @@ namespace sg {
 namespace {
 
 template <class S>
-double d(S v) { return ScalarTraits<S>::toDouble(v); }
+double d(S v) {
+  return ScalarTraits<S>::toDouble(v);
+}
 
 template <class S>
 void checkInterpolation(int k, int64_t nx, int64_t nz, double tolerance) {
@@ -159,9 +161,12 @@ void checkConstantWeightRowsMatchGeneric(int k, bool window = true) {
   }
   for (int64_t j = pw.originJ; k > 1 && j < pw.originJ + pw.sizeJ; ++j) {
     updatePatchRow<S>(generic, pw, j, g.window, dx, dy, dz, c, scratch.data());
-    if (k == 2) updatePatchRow<S, 2>(constant, pw, j, g.window, dx, dy, dz, c, scratch.data());
-    else if (k == 4) updatePatchRow<S, 4>(constant, pw, j, g.window, dx, dy, dz, c, scratch.data());
-    else updatePatchRow<S>(constant, pw, j, g.window, dx, dy, dz, c, scratch.data());
+    if (k == 2)
+      updatePatchRow<S, 2>(constant, pw, j, g.window, dx, dy, dz, c, scratch.data());
+    else if (k == 4)
+      updatePatchRow<S, 4>(constant, pw, j, g.window, dx, dy, dz, c, scratch.data());
+    else
+      updatePatchRow<S>(constant, pw, j, g.window, dx, dy, dz, c, scratch.data());
     compared += pw.sizeI;
   }
   EXPECT_EQ(compared, pw.sizeI * pw.sizeJ);
@@ -196,9 +201,23 @@ namespace {
 template <class S, int K>
 void checkUncheckedLerp() {
   using Raw = typename S::RawType;
-  std::vector<Raw> values = {0, 1, -1, 2, -2, 3, -3, 5, -5, std::numeric_limits<Raw>::max(), std::numeric_limits<Raw>::min(),
-                             Raw(std::numeric_limits<Raw>::max() - 1), Raw(std::numeric_limits<Raw>::min() + 1),
-                             S::kOneRaw, Raw(-S::kOneRaw), Raw(S::kOneRaw / 2 + 1), Raw(-(S::kOneRaw / 2) - 1)};
+  std::vector<Raw> values = {0,
+                             1,
+                             -1,
+                             2,
+                             -2,
+                             3,
+                             -3,
+                             5,
+                             -5,
+                             std::numeric_limits<Raw>::max(),
+                             std::numeric_limits<Raw>::min(),
+                             Raw(std::numeric_limits<Raw>::max() - 1),
+                             Raw(std::numeric_limits<Raw>::min() + 1),
+                             S::kOneRaw,
+                             Raw(-S::kOneRaw),
+                             Raw(S::kOneRaw / 2 + 1),
+                             Raw(-(S::kOneRaw / 2) - 1)};
   uint64_t x = 0x9E3779B97F4A7C15ull;  // splitmix64: a fixed, reproducible set of random values
   for (int i = 0; i < 4000; ++i) {
     x += 0x9E3779B97F4A7C15ull;

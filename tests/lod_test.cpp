@@ -28,7 +28,8 @@ Scenario windowedMeadow() {
   s.lod.centerX = s.lod.centerZ = Rational{-18, 1};
   s.markings.length = Rational{20, 1};
   s.markings.width = Rational{12, 1};
-  s.bodies.list[0].position = {Rational{-20, 1}, *Rational::make(45, 100), Rational{-19, 1}};  // the mower, near the window
+  s.bodies.list[0].position = {Rational{-20, 1}, *Rational::make(45, 100),
+                               Rational{-19, 1}};  // the mower, near the window
   s.bodies.list[1].position = {Rational{-18, 1}, *Rational::make(4, 10), Rational{-18, 1}};
   s.camera.clear();
   for (int t = 0; t <= 240; t += 2) {  // out to (+18, +18) by tick 120, back by tick 240

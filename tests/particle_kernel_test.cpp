@@ -5,8 +5,8 @@
 // rounding boundaries of |d| and L / |d| (where the kernel's double guesses are wrong by one and
 // must hand the block to the reference), on particles at their anchor, and on states that
 // overflow. The patch stage (sim/patches/patch_row_avx2.cpp): the row blend (1/4, 1/2, 3/4), the
-// k = 2 and 4 interpolation along x and the patch writes on edge and random values. Then whole worlds: every tick's hash and every patch's derived
-// state equal between the two kernels on the golden scenarios.
+// k = 2 and 4 interpolation along x and the patch writes on edge and random values. Then whole worlds: every tick's
+// hash and every patch's derived state equal between the two kernels on the golden scenarios.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -15,8 +15,8 @@
 #include <limits>
 #include <random>
 #include <string>
-#include <utility>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "replay/scenario_files.h"
@@ -334,10 +334,17 @@ Raw<S> interestingRaw(std::mt19937_64& rng) {
   using U = std::make_unsigned_t<Raw<S>>;
   U v = shift >= bits - 1 ? U(std::numeric_limits<Raw<S>>::max()) : U(U(1) << shift);
   switch (rng() % 4) {  // exactly the power, a little below, a little above, or random below
-    case 1: v -= U(rng() % 7); break;
-    case 2: if (shift < bits - 1) v += U(rng() % 7); break;
-    case 3: v = shift == 0 ? v : U(rng() % v); break;
-    default: break;
+    case 1:
+      v -= U(rng() % 7);
+      break;
+    case 2:
+      if (shift < bits - 1) v += U(rng() % 7);
+      break;
+    case 3:
+      v = shift == 0 ? v : U(rng() % v);
+      break;
+    default:
+      break;
   }
   const Raw<S> r = Raw<S>(v);
   return rng() % 2 ? Raw<S>(U(0) - U(r)) : r;  // wraps at the extreme: also interesting
@@ -412,8 +419,24 @@ TYPED_TEST(AvxKernel, ConstantsOutsideTheKernelsRangeRunTheReference) {
 template <class S>
 std::vector<Raw<S>> edgeAndRandomRaws(std::mt19937_64& rng, size_t randomCount) {
   using L = std::numeric_limits<Raw<S>>;
-  std::vector<Raw<S>> v{0, 1, -1, 2, -2, 3, -3, 5, -5, 7, -7, L::max(), L::min(), Raw<S>(L::max() - 1),
-                        Raw<S>(L::min() + 1), Raw<S>(L::max() / 2), Raw<S>(L::min() / 2), Raw<S>(L::max() / 2 + 1)};
+  std::vector<Raw<S>> v{0,
+                        1,
+                        -1,
+                        2,
+                        -2,
+                        3,
+                        -3,
+                        5,
+                        -5,
+                        7,
+                        -7,
+                        L::max(),
+                        L::min(),
+                        Raw<S>(L::max() - 1),
+                        Raw<S>(L::min() + 1),
+                        Raw<S>(L::max() / 2),
+                        Raw<S>(L::min() / 2),
+                        Raw<S>(L::max() / 2 + 1)};
   for (size_t i = 0; i < randomCount; ++i) v.push_back(interestingRaw<S>(rng));
   return v;
 }
@@ -433,9 +456,10 @@ TYPED_TEST(AvxKernel, PatchRowBlendMatchesTheUncheckedLerp) {
     for (size_t len : {n, size_t(13), size_t(1), size_t(0)}) {  // tails of every length
       blendRowsAvx2(a.data(), b.data(), out.data(), int64_t(len), quarters);
       for (size_t i = 0; i < len; ++i) {
-        const S expected = k == 2 ? unchecked::lerpByFraction<S, 2>(a[i], b[i], t)
-                                  : unchecked::lerpByFraction<S, 4>(a[i], b[i], t);
-        ASSERT_EQ(out[i].raw(), expected.raw()) << "a " << a[i].raw() << " b " << b[i].raw() << " t/k " << t << "/" << k;
+        const S expected =
+            k == 2 ? unchecked::lerpByFraction<S, 2>(a[i], b[i], t) : unchecked::lerpByFraction<S, 4>(a[i], b[i], t);
+        ASSERT_EQ(out[i].raw(), expected.raw())
+            << "a " << a[i].raw() << " b " << b[i].raw() << " t/k " << t << "/" << k;
       }
     }
   }
@@ -573,29 +597,27 @@ TEST_P(KernelWorlds, EveryTickHashEqualBetweenKernels) {
     ASSERT_TRUE(reference->step(in).ok) << "tick " << t;
     ASSERT_TRUE(vector->step(in).ok) << "tick " << t;
     ASSERT_EQ(reference->stateHash(), vector->stateHash()) << c.scenario << " " << c.scalar << " tick " << t;
-    if (s.scalar == ScalarKind::Fx32) expectSamePatches<Fx32>(*reference, *vector, t);
-    else expectSamePatches<Fx16>(*reference, *vector, t);
+    if (s.scalar == ScalarKind::Fx32)
+      expectSamePatches<Fx32>(*reference, *vector, t);
+    else
+      expectSamePatches<Fx16>(*reference, *vector, t);
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Scenarios, KernelWorlds,
-                         ::testing::Values(WorldCase{"thesis-bodies", "fx32", 1, false},
-                                           WorldCase{"thesis-bodies", "fx16", 1, false},
-                                           WorldCase{"thesis-bodies", "fx32", 2, true},
-                                           WorldCase{"thesis-bodies", "fx16", 2, true},
-                                           WorldCase{"mower-field", "fx32", 2, false},
-                                           WorldCase{"mower-field", "fx16", 1, false},
-                                           WorldCase{"lod-crossing", "fx32", 2, false},
-                                           WorldCase{"lod-crossing", "fx16", 4, false},
-                                           WorldCase{"thesis-bodies", "fx32", 4, false},
-                                           WorldCase{"hilly-meadow", "fx16", 4, true}),
-                         [](const auto& info) {
-                           const WorldCase& c = info.param;
-                           std::string n = std::string(c.scenario) + "_" + c.scalar + "_k" + std::to_string(c.k) +
-                                           (c.pbd ? "_pbd" : "");
-                           for (char& ch : n) if (ch == '-') ch = '_';
-                           return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    Scenarios, KernelWorlds,
+    ::testing::Values(WorldCase{"thesis-bodies", "fx32", 1, false}, WorldCase{"thesis-bodies", "fx16", 1, false},
+                      WorldCase{"thesis-bodies", "fx32", 2, true}, WorldCase{"thesis-bodies", "fx16", 2, true},
+                      WorldCase{"mower-field", "fx32", 2, false}, WorldCase{"mower-field", "fx16", 1, false},
+                      WorldCase{"lod-crossing", "fx32", 2, false}, WorldCase{"lod-crossing", "fx16", 4, false},
+                      WorldCase{"thesis-bodies", "fx32", 4, false}, WorldCase{"hilly-meadow", "fx16", 4, true}),
+    [](const auto& info) {
+      const WorldCase& c = info.param;
+      std::string n = std::string(c.scenario) + "_" + c.scalar + "_k" + std::to_string(c.k) + (c.pbd ? "_pbd" : "");
+      for (char& ch : n)
+        if (ch == '-') ch = '_';
+      return n;
+    });
 
 TEST(ParticleKernelChoice, ScalarWorldsStayScalarAndNamesAreStable) {
   auto w = makeWorld(test::thesisMeadow(), 1);

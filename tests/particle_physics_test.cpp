@@ -12,7 +12,9 @@ namespace {
 using test::makeTyped;
 
 template <class S>
-double d(S v) { return ScalarTraits<S>::toDouble(v); }
+double d(S v) {
+  return ScalarTraits<S>::toDouble(v);
+}
 
 // ---- a tuft started upright with zero velocity and no wind stays exactly upright ----------------
 
@@ -110,8 +112,10 @@ double measurePeriod(const Rational& dt, double theta0, int periods) {
   auto& p = w->mutableParticles();
   const S L = w->particleConstants().rodLength;
   // Start at angle theta0 from the vertical in the x-y plane, at rest.
-  p.px[0] = p.anchorX[0] + *ScalarTraits<S>::fromRational(*Rational::make(int64_t(std::llround(std::sin(theta0) * 1e12)), int64_t(1e12)));
-  p.py[0] = p.anchorY[0] + *ScalarTraits<S>::fromRational(*Rational::make(int64_t(std::llround(std::cos(theta0) * 1e12)), int64_t(1e12)));
+  p.px[0] = p.anchorX[0] + *ScalarTraits<S>::fromRational(
+                               *Rational::make(int64_t(std::llround(std::sin(theta0) * 1e12)), int64_t(1e12)));
+  p.py[0] = p.anchorY[0] + *ScalarTraits<S>::fromRational(
+                               *Rational::make(int64_t(std::llround(std::cos(theta0) * 1e12)), int64_t(1e12)));
   p.vx[0] = p.vy[0] = p.vz[0] = S(0);
   (void)L;
   const double h = dt.toDouble();

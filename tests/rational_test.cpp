@@ -259,11 +259,11 @@ int cmpWithScaled(U128 n, U128 d, U128 m, int e) {
   if ((c < 0) != (r.num < 0) || c == 0) return ::testing::AssertionFailure() << "sign or zero";
   int ex = 0;
   const double f = std::frexp(std::fabs(c), &ex);  // exact
-  const uint64_t m = uint64_t(std::ldexp(f, 53));    // exact: 2^52 <= m < 2^53
+  const uint64_t m = uint64_t(std::ldexp(f, 53));  // exact: 2^52 <= m < 2^53
   const int e = ex - 53;
   const int above = cmpWithScaled(n, d, 2 * U128(m) + 1, e - 1);
   const int below = m == (uint64_t(1) << 52) ? cmpWithScaled(n, d, 4 * U128(m) - 1, e - 2)
-                                              : cmpWithScaled(n, d, 2 * U128(m) - 1, e - 1);
+                                             : cmpWithScaled(n, d, 2 * U128(m) - 1, e - 1);
   if (above > 0 || below < 0) return ::testing::AssertionFailure() << "not the nearest double";
   if ((above == 0 || below == 0) && (m & 1) != 0) return ::testing::AssertionFailure() << "tie not to even";
   return ::testing::AssertionSuccess();
@@ -339,7 +339,7 @@ TEST(RationalRounding, ScaledIntegerMatchesExactReference) {
   const int fracs[] = {0, 1, 16, 32, 62};
   for (int i = 0; i < 100000; ++i) {
     const I128 n = I128(int64_t(g()) >> (4 + g() % 60));  // |n| < 2^60
-    const I128 d = I128((g() >> (4 + g() % 60)) | 1);   // 1 <= d < 2^60
+    const I128 d = I128((g() >> (4 + g() % 60)) | 1);     // 1 <= d < 2^60
     const Rational r = *Rational::make(n, d);
     const int f = fracs[i % 5];
     const I128 want = refRoundDiv(r.num * (I128(1) << f), r.den);  // |num| 2^62 < 2^122: exact
@@ -431,7 +431,8 @@ TEST(RationalArithmetic, CompareIsExactForAnySize) {
     if (!b) continue;
     const int sa = a->num < 0 ? -1 : 1, sb = b->num < 0 ? -1 : (b->num > 0 ? 1 : 0);
     int want = sa != sb ? (sa < sb ? -1 : 1)
-                        : sa * cmpBig(mulBig(big(mag(a->num)), big(U128(b->den))), mulBig(big(mag(b->num)), big(U128(a->den))));
+                        : sa * cmpBig(mulBig(big(mag(a->num)), big(U128(b->den))),
+                                      mulBig(big(mag(b->num)), big(U128(a->den))));
     ASSERT_EQ(sg::compare(*a, *b), want) << str(*a) << " <=> " << str(*b);
     ASSERT_EQ(sg::compare(*b, *a), -want);
   }
@@ -559,8 +560,8 @@ const long double kPowAbs = 4.0L * std::ldexp(1.0L, -62);
   const long double err = fabsl(g - ref);
   std::ostringstream o;
   o.precision(21);
-  o << baseText << " ^ " << expText << ": got " << g << " (" << str(got) << "), powl " << ref << ", error "
-    << err << " (" << double(err / ref) << " relative)";
+  o << baseText << " ^ " << expText << ": got " << g << " (" << str(got) << "), powl " << ref << ", error " << err
+    << " (" << double(err / ref) << " relative)";
   // Documented form: an exact fraction raw / 2^62.
   if (got.den <= 0 || (got.den & (got.den - 1)) != 0 || got.den > (I128(1) << 62))
     return ::testing::AssertionFailure() << o.str() << ": denominator is not a power of two <= 2^62";
@@ -614,7 +615,7 @@ TEST(RationalPow, ManyDigitInputsDoNotOverflow) {
 /// Results below 2^-63 round to 0 in Q2.62; a huge exponent must not overflow the product
 /// exponent * ln(base) into a wrong, large result.
 TEST(RationalPow, HugeExponentsUnderflowToZero) {
-  EXPECT_TRUE(powClose("1e-36", "1"));  // 1e-36 < 2^-63: 0 within the absolute tolerance
+  EXPECT_TRUE(powClose("1e-36", "1"));       // 1e-36 < 2^-63: 0 within the absolute tolerance
   EXPECT_TRUE(powClose("0.999", "100000"));  // e^-100
   EXPECT_TRUE(powClose("0.97", "1000000"));
   EXPECT_TRUE(powClose("0.5", "1000000000"));

@@ -9,9 +9,9 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "replay/cli/cli_common.h"
 #include "replay/format/sgr_reader.h"
 #include "replay/format/sgr_writer.h"
-#include "replay/cli/cli_common.h"
 #include "sim/world/world.h"
 #include "tests/cli_support.h"
 #include "tests/test_support.h"

@@ -12,6 +12,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <xxhash.h>
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -24,7 +25,6 @@
 #include <string>
 #include <thread>
 #include <vector>
-#include <xxhash.h>
 
 #include "replay/cli/cli_common.h"
 #include "replay/format/sgr_reader.h"
@@ -65,8 +65,12 @@ std::vector<Expectation> loadExpectations() {
   const json j = json::parse(readFile(corpusDir() / "EXPECTED.json"));
   std::vector<Expectation> out;
   for (const auto& [file, e] : j.at("files").items()) {
-    Expectation x{file, e.at("kind").get<std::string>(), e.at("outcome").get<std::string>(),
-                  e.value("message", std::string()), std::nullopt, std::nullopt};
+    Expectation x{file,
+                  e.at("kind").get<std::string>(),
+                  e.at("outcome").get<std::string>(),
+                  e.value("message", std::string()),
+                  std::nullopt,
+                  std::nullopt};
     if (e.contains("offset")) x.offset = e["offset"].get<uint64_t>();
     if (e.contains("truncatedAt")) x.truncatedAt = e["truncatedAt"].get<uint64_t>();
     out.push_back(x);
@@ -138,9 +142,9 @@ TEST(RecordingRobustness, EveryCorpusFileIsListedWithItsExpectedOutcome) {
     EXPECT_TRUE(e.outcome == "error" || e.outcome == "truncated") << e.file << ": " << e.outcome;
     EXPECT_TRUE(e.outcome == "error" ? e.offset.has_value() : e.truncatedAt.has_value()) << e.file;
   }
-  for (const char* kind : {"cut", "cut-head", "cut-preamble", "flip-type", "flip-length", "flip-payload",
-                           "flip-checksum", "magic", "version", "unknown-type", "absurd-length", "zstd",
-                           "body-index", "scenario"})
+  for (const char* kind :
+       {"cut", "cut-head", "cut-preamble", "flip-type", "flip-length", "flip-payload", "flip-checksum", "magic",
+        "version", "unknown-type", "absurd-length", "zstd", "body-index", "scenario"})
     EXPECT_TRUE(kinds.count(kind)) << "no damaged file of kind " << kind;
 }
 
@@ -152,8 +156,8 @@ TEST(RecordingRobustness, EveryDamagedFileGivesItsExpectedOutcomeInProcess) {
     const Outcome o = readThrough(path);  // cut-off files replay and verify up to the cut
     EXPECT_EQ(o.outcome, e.outcome) << e.file << " (" << e.kind << "), at " << o.step << ": " << o.message;
     if (o.outcome != e.outcome) continue;
-    EXPECT_TRUE(contains(o.message, e.message)) << e.file << ": expected a message containing '" << e.message
-                                                << "', got: " << o.message;
+    EXPECT_TRUE(contains(o.message, e.message))
+        << e.file << ": expected a message containing '" << e.message << "', got: " << o.message;
     if (e.outcome == "error") {
       EXPECT_EQ(o.offset, *e.offset) << e.file << ": " << o.message;
       const std::string prefix = path + ": byte " + std::to_string(o.offset) + ": expected ";
@@ -263,9 +267,9 @@ TEST(RecordingRobustness, RecorderKilledMidWriteReplaysUpToTheCut) {
   const size_t wantSnapshots = 2;
   TempDir dir;
   const std::string recording = dir.file("killed.sgr");
-  Child child({SIMGRASS_CLI, "record", scenario, "-o", recording, "--ticks", "100000", "--snapshot-every",
-               slow ? "15" : "100"},
-              dir.file("recorder.log"));
+  Child child(
+      {SIMGRASS_CLI, "record", scenario, "-o", recording, "--ticks", "100000", "--snapshot-every", slow ? "15" : "100"},
+      dir.file("recorder.log"));
   ASSERT_GT(child.pid(), 0) << "cannot start " << SIMGRASS_CLI;
 
   // Wait (at most 60 s) until the file holds enough hashes and snapshots.

@@ -168,9 +168,9 @@ TEST(RenderObj, BadFilesGiveOneLineWithTheirLineNumber) {
   const struct {
     const char* file;
     int line;
-  } cases[] = {{"bad-number.obj", 3},   {"short-vertex.obj", 3}, {"index-range.obj", 5},    {"zero-index.obj", 4},
-               {"short-face.obj", 3},   {"normal-range.obj", 6}, {"no-faces.obj", 4},       {"negative-range.obj", 4},
-               {"bad-texture.obj", 4},  {"not-finite.obj", 5},   {"does-not-exist.obj", 0}};
+  } cases[] = {{"bad-number.obj", 3},  {"short-vertex.obj", 3}, {"index-range.obj", 5},   {"zero-index.obj", 4},
+               {"short-face.obj", 3},  {"normal-range.obj", 6}, {"no-faces.obj", 4},      {"negative-range.obj", 4},
+               {"bad-texture.obj", 4}, {"not-finite.obj", 5},   {"does-not-exist.obj", 0}};
   for (const auto& c : cases) {
     viewer::ObjMesh mesh;
     std::string error;
@@ -235,7 +235,8 @@ TEST(RenderMesh, MeshBodiesChangeTheImageAndAMissingMeshFallsBackToPrimitives) {
   const Image meshImage = renderWith(scene, camera, options);
   EXPECT_EQ(r.renderer().lastAssetError(), "");
   const Image proxyImage = renderWith(withProxies(scene), camera, options);
-  EXPECT_GT(differingFraction(meshImage, proxyImage, 8), 0.002) << "the rock and the crate look unlike a sphere and a box";
+  EXPECT_GT(differingFraction(meshImage, proxyImage, 8), 0.002)
+      << "the rock and the crate look unlike a sphere and a box";
 
   Scene missing = scene;
   for (auto& b : missing.bodyParts)
@@ -357,7 +358,8 @@ TEST(RenderRock, SteepGroundMovesTowardTheRockColourAndFlatGroundKeepsItsOwn) {
   const Image withRock = renderWith(scene, camera, on), without = renderWith(scene, camera, off);
   // The textures' mean colours, independent of the renderer.
   const viewer::TuftAtlas atlas = viewer::makeTuftAtlas(scene.atlasVariants, scene.atlasSeed);
-  const Image rockTex = viewer::makeRockTexture(scene.atlasSeed), groundTex = viewer::makeGroundTexture(atlas, scene.atlasSeed);
+  const Image rockTex = viewer::makeRockTexture(scene.atlasSeed),
+              groundTex = viewer::makeGroundTexture(atlas, scene.atlasSeed);
   double towardRock[3];
   for (int c = 0; c < 3; ++c) {
     double r = 0, g = 0;
@@ -370,7 +372,8 @@ TEST(RenderRock, SteepGroundMovesTowardTheRockColourAndFlatGroundKeepsItsOwn) {
   const auto f = camera.forward();
   const float rl = std::sqrt(f[0] * f[0] + f[2] * f[2]);
   const float right[3] = {-f[2] / rl, 0, f[0] / rl};
-  const float up[3] = {right[1] * f[2] - right[2] * f[1], right[2] * f[0] - right[0] * f[2], right[0] * f[1] - right[1] * f[0]};
+  const float up[3] = {right[1] * f[2] - right[2] * f[1], right[2] * f[0] - right[0] * f[2],
+                       right[0] * f[1] - right[1] * f[0]};
   const float tanY = std::tan(0.5f * camera.fovYDegrees * Camera::kRadians), aspect = float(kWidth) / kHeight;
   int flat = 0, flatChanged = 0, steep = 0;
   double shiftDot = 0, shiftMagnitude = 0;
@@ -618,8 +621,9 @@ TEST(RenderFeaturesCli, FeatureFlagsRenderAndBadValuesExit2) {
     if (b.contains("mesh")) b["mesh"] = test::sourcePath("scenarios/" + b["mesh"].get<std::string>());
   const std::string scenario = dir.write("small-mesh.json", j.dump(2));
   const std::string out = " -o " + quote(dir.file("out"));
-  const CliResult r = runCli("render " + quote(scenario) +
-                             " --size 64x48 --ssao --alpha-test --no-rock --debug particles,cells,contacts --json" + out);
+  const CliResult r =
+      runCli("render " + quote(scenario) +
+             " --size 64x48 --ssao --alpha-test --no-rock --debug particles,cells,contacts --json" + out);
   ASSERT_EQ(r.exitCode, 0) << r.describe();
   const json res = parseJson(r);
   EXPECT_EQ(res.value("ssao", false), true);

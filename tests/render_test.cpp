@@ -233,8 +233,9 @@ TEST(Render, BodiesAndMarkingsReachTheScene) {
   viewer::extractScene(*world, scenario, &scene);
   EXPECT_EQ(scene.tufts.size(), size_t(151 * 151));
   EXPECT_EQ(scene.bodyParts.size(), size_t(5)) << "the mower: a deck and four wheels";
-  const size_t marking = size_t(std::count_if(scene.tufts.begin(), scene.tufts.end(),
-                                              [&](const viewer::TuftInstance& t) { return t.variant == scene.atlasVariants; }));
+  const size_t marking =
+      size_t(std::count_if(scene.tufts.begin(), scene.tufts.end(),
+                           [&](const viewer::TuftInstance& t) { return t.variant == scene.atlasVariants; }));
   EXPECT_GT(marking, size_t(500)) << "white marking tufts";
   EXPECT_FALSE(scene.ground.heights.empty());
   EXPECT_EQ(scene.ground.heights.size(), scene.ground.xs.size() * scene.ground.zs.size());
@@ -299,9 +300,9 @@ TEST(RenderCli, BadArgumentsGiveOneLineAndExitCode2) {
   TempDir dir;
   const std::string scenario = smallScenario(dir);
   const std::string out = " -o " + quote(dir.file("out"));
-  const char* bad[] = {"--ticks 5:1", "--ticks abc", "--ticks 1:2:0", "--ticks -3", "--ticks 1:2:3:4",
-                       "--ticks 0:99999999999", "--size 10x10", "--size 64", "--size 64x", "--size axb",
-                       "--camera 1,2,3", "--msaa 3"};
+  const char* bad[] = {"--ticks 5:1",           "--ticks abc",  "--ticks 1:2:0", "--ticks -3", "--ticks 1:2:3:4",
+                       "--ticks 0:99999999999", "--size 10x10", "--size 64",     "--size 64x", "--size axb",
+                       "--camera 1,2,3",        "--msaa 3"};
   for (const std::string args : bad) {
     const CliResult r = runCli("render " + quote(scenario) + " " + args + out);
     EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.describe();

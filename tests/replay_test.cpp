@@ -63,8 +63,8 @@ TEST_P(RecordReplay, EveryCheckMatchesAndSeekEqualsTheUninterruptedRun) {
   RecordSettings settings;
   settings.snapshotEvery = uint32_t(std::max<int64_t>(2, ticks / 3));
   settings.checkEvery = 1;
-  const Recorded rec = recordScenario(dir, test::sourcePath(std::string("scenarios/") + scenarioCase.file), scalar,
-                                      ticks, settings);
+  const Recorded rec =
+      recordScenario(dir, test::sourcePath(std::string("scenarios/") + scenarioCase.file), scalar, ticks, settings);
   const sgr::Recording& r = rec.recording;
   ASSERT_TRUE(r.end.has_value());
   EXPECT_FALSE(r.truncated);
@@ -91,7 +91,7 @@ TEST_P(RecordReplay, EveryCheckMatchesAndSeekEqualsTheUninterruptedRun) {
 }
 
 const ScenarioCase kScenarios[] = {
-    {"thesis-meadow.json", 60}, {"hilly-meadow.json", 60}, {"thesis-bodies.json", 90},
+    {"thesis-meadow.json", 60}, {"hilly-meadow.json", 60},  {"thesis-bodies.json", 90},
     {"mower-field.json", 90},   {"million-meadow.json", 4}, {"lod-crossing.json", 90},
 };
 INSTANTIATE_TEST_SUITE_P(Scenarios, RecordReplay,
@@ -112,7 +112,8 @@ TEST(RecordReplay, SnapshotsAloneAreEnoughToSeek) {
   RecordSettings settings;
   settings.checkEvery = 0;
   settings.snapshotEvery = 5;
-  const Recorded rec = recordScenario(dir, test::sourcePath("scenarios/thesis-bodies.json"), ScalarKind::Fx32, 17, settings);
+  const Recorded rec =
+      recordScenario(dir, test::sourcePath("scenarios/thesis-bodies.json"), ScalarKind::Fx32, 17, settings);
   EXPECT_TRUE(rec.recording.checks.empty());
   Player player(rec.recording);
   ASSERT_TRUE(player.seek(12).ok);
@@ -147,7 +148,8 @@ TEST(RecordReplay, OnlyChangedInputIsWritten) {
       TickInput in;
       in.hasCamera = true;
       in.camera = InputVec3{int64_t(t < 10 ? 1 : 2) << 32, 0, 0};
-      if (t == 3 || t == 15) in.bodies.push_back(BodyCommand{1, BodyCommandKind::AddVelocity, InputVec3{int64_t(1) << 31, 0, 0}});
+      if (t == 3 || t == 15)
+        in.bodies.push_back(BodyCommand{1, BodyCommandKind::AddVelocity, InputVec3{int64_t(1) << 31, 0, 0}});
       ASSERT_TRUE(recorder.step(in).ok);
     }
     recorder.finish();
@@ -198,11 +200,14 @@ TEST(RecordingReader, ChecksMustFollowTheirIntervalAndEndMustBeCoveredByThem) {
   auto end = [](int64_t t) { return std::make_pair(T::End, sgr::encodeEnd({t, 7, false, ""})); };
   EXPECT_EQ(readerError(assemble({head, check(2), check(4), end(5)})), "no error");
   // A missing CHCK (tick 4 dropped) is damage, not a shorter recording.
-  EXPECT_NE(readerError(assemble({head, check(2), check(6)})).find("expected the check of tick 4, got tick 6"), std::string::npos);
-  // An END far beyond the last check would make a replay run for ever.
-  EXPECT_NE(readerError(assemble({head, check(2), end(1000000000000)})).find("a final tick from 2 to before the next check at 4"),
+  EXPECT_NE(readerError(assemble({head, check(2), check(6)})).find("expected the check of tick 4, got tick 6"),
             std::string::npos);
-  EXPECT_NE(readerError(assemble({head, std::make_pair(T::Snapshot, sgr::encodeSnapshot(5, 1, std::vector<uint8_t>(9, 1), 1))}))
+  // An END far beyond the last check would make a replay run for ever.
+  EXPECT_NE(readerError(assemble({head, check(2), end(1000000000000)}))
+                .find("a final tick from 2 to before the next check at 4"),
+            std::string::npos);
+  EXPECT_NE(readerError(
+                assemble({head, std::make_pair(T::Snapshot, sgr::encodeSnapshot(5, 1, std::vector<uint8_t>(9, 1), 1))}))
                 .find("no SNAP chunk (HEAD says snapshotEvery = 0)"),
             std::string::npos);
   EXPECT_NE(readerError(assemble({check(2)})).find("byte 12: expected the HEAD chunk first"), std::string::npos);
@@ -212,7 +217,8 @@ TEST(InputTrack, CameraKeysHoldAndCommandsApplyOnTheirTick) {
   const Scenario s = loadScenarioFile(test::sourcePath("scenarios/thesis-bodies.json"));
   const InputTrack track = parseInputTrack(R"({"format": "simgrass-input-track/1", "ticks": 30,
       "camera": [{"tick": 0, "position": [0, 2, 5]}, {"tick": 10, "position": ["1/3", 2, 5]}],
-      "commands": [{"tick": 4, "body": ")" + s.bodies.list[0].name + R"(", "command": "addVelocity", "value": [1, 0, 0]}]})",
+      "commands": [{"tick": 4, "body": ")" + s.bodies.list[0].name +
+                                               R"(", "command": "addVelocity", "value": [1, 0, 0]}]})",
                                            "track.json", s);
   EXPECT_EQ(track.ticks, 30);
   EXPECT_EQ(trackInput(track, 9).camera.x, 0);
@@ -233,16 +239,21 @@ TEST(InputTrack, ErrorsNameTheFileAndJsonPath) {
     return std::string("no error");
   };
   EXPECT_EQ(error(R"({"ticks": 3})"), R"(track.json: $.format: expected "simgrass-input-track/1", got null)");
-  EXPECT_EQ(error(R"({"format": "simgrass-input-track/1", "camera": [{"tick": 5, "position": [0,0,0]}, {"tick": 5, "position": [0,0,0]}]})"),
-            "track.json: $.camera[1].tick: expected a tick after the previous camera key's 5, got 5");
-  EXPECT_EQ(error(R"({"format": "simgrass-input-track/1", "commands": [{"tick": 1, "body": "nobody", "command": "displace", "value": [0,0,0]}]})"),
-            R"(track.json: $.commands[0].body: expected the name of a body in $.bodies.list, got "nobody")");
+  EXPECT_EQ(
+      error(
+          R"({"format": "simgrass-input-track/1", "camera": [{"tick": 5, "position": [0,0,0]}, {"tick": 5, "position": [0,0,0]}]})"),
+      "track.json: $.camera[1].tick: expected a tick after the previous camera key's 5, got 5");
+  EXPECT_EQ(
+      error(
+          R"({"format": "simgrass-input-track/1", "commands": [{"tick": 1, "body": "nobody", "command": "displace", "value": [0,0,0]}]})"),
+      R"(track.json: $.commands[0].body: expected the name of a body in $.bodies.list, got "nobody")");
   EXPECT_NE(error(R"({"format": "simgrass-input-track/1", "ticks": -1})").find("$.ticks"), std::string::npos);
   EXPECT_NE(error("{").find("valid JSON"), std::string::npos);
 }
 
 TEST(Variant, ParsesDescribesAndOverrides) {
-  const VariantSettings v = VariantSettings::parse("scalar=fx16, interp=2 dt=1/120 broadphase=brute body-broadphase=sap threads=3");
+  const VariantSettings v =
+      VariantSettings::parse("scalar=fx16, interp=2 dt=1/120 broadphase=brute body-broadphase=sap threads=3");
   EXPECT_EQ(v.describe(), "scalar=fx16 interp=2 broadphase=brute body-broadphase=sap dt=1/120 threads=3");
   EXPECT_EQ(VariantSettings::parse(v.describe()).describe(), v.describe());
   const VariantSettings base = VariantSettings::resolvedFrom(test::thesisMeadow());
@@ -304,7 +315,8 @@ TEST(ReplayCli, RecordVerifySeekExportAndInfo) {
   EXPECT_EQ(v["ticks"], 40);
   EXPECT_EQ(v["hash"], finalHash);
 
-  const CliResult seek = runCli("replay " + quote(sgr) + " --to 22 --export-state " + quote(dir.file("s22.bin")) + " --json");
+  const CliResult seek =
+      runCli("replay " + quote(sgr) + " --to 22 --export-state " + quote(dir.file("s22.bin")) + " --json");
   ASSERT_EQ(seek.exitCode, 0) << seek.describe();
   const json s = parseJson(seek);
   EXPECT_EQ(s["tick"], 22);
@@ -325,7 +337,9 @@ TEST(ReplayCli, ExportStateAsJsonHoldsTheBinaryStatesNumbers) {
   TempDir dir;
   const std::string sgr = dir.file("b.sgr");
   ASSERT_EQ(runCli("record " + quote(test::sourcePath("scenarios/thesis-bodies.json")) + " -o " + quote(sgr) +
-                   " --ticks 30 --json").exitCode, 0);
+                   " --ticks 30 --json")
+                .exitCode,
+            0);
   const CliResult bin = runCli("replay " + quote(sgr) + " --to 22 --export-state " + quote(dir.file("s.bin")));
   ASSERT_EQ(bin.exitCode, 0) << bin.describe();
   const CliResult js = runCli("replay " + quote(sgr) + " --to 22 --export-state " + quote(dir.file("s.json")));
@@ -356,9 +370,11 @@ TEST(ReplayCli, ExportStateAsJsonHoldsTheBinaryStatesNumbers) {
   ASSERT_EQ(s["bodies"].size(), bodies.length / (13 * 8 + 8));
   for (size_t b = 0; b < s["bodies"].size(); ++b)
     for (int a = 0; a < 3; ++a)
-      EXPECT_EQ(s["bodies"][b]["position"][size_t(a)].get<double>(),
-                double(loadLE<int64_t>(state.data() + bodies.payloadAt + b * (13 * 8 + 8) + 8 * size_t(a))) / 4294967296.0);
-  EXPECT_EQ(int64_t(s["patches"]["tipOffset"].size()), 3 * s["patches"]["countX"].get<int64_t>() * s["patches"]["countZ"].get<int64_t>());
+      EXPECT_EQ(
+          s["bodies"][b]["position"][size_t(a)].get<double>(),
+          double(loadLE<int64_t>(state.data() + bodies.payloadAt + b * (13 * 8 + 8) + 8 * size_t(a))) / 4294967296.0);
+  EXPECT_EQ(int64_t(s["patches"]["tipOffset"].size()),
+            3 * s["patches"]["countX"].get<int64_t>() * s["patches"]["countZ"].get<int64_t>());
   // A folder that does not exist: one line, exit 2, nothing left behind.
   const CliResult bad = runCli("replay " + quote(sgr) + " --to 22 --export-state " + quote(dir.file("no/such/s.json")));
   EXPECT_EQ(bad.exitCode, 2);
@@ -383,8 +399,9 @@ TEST(ReplayCli, RecordWithAnInputTrackAndAVariant) {
   const CliResult bad = runCli("record -o " + quote(dir.file("x.sgr")) + " --variant interp=7");
   EXPECT_EQ(bad.exitCode, 2);
   EXPECT_TRUE(isOneLine(bad.err)) << bad.err;
-  const CliResult badTrack = runCli("record " + quote(test::sourcePath("scenarios/thesis-bodies.json")) + " -o " +
-                                    quote(dir.file("y.sgr")) + " --input " + quote(dir.write("bad.json", "{\"format\": 3}")));
+  const CliResult badTrack =
+      runCli("record " + quote(test::sourcePath("scenarios/thesis-bodies.json")) + " -o " + quote(dir.file("y.sgr")) +
+             " --input " + quote(dir.write("bad.json", "{\"format\": 3}")));
   EXPECT_EQ(badTrack.exitCode, 2);
   EXPECT_TRUE(isOneLine(badTrack.err)) << badTrack.err;
   EXPECT_NE(badTrack.err.find("bad.json: $.format"), std::string::npos) << badTrack.err;

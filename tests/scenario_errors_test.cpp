@@ -109,8 +109,8 @@ testing::AssertionResult throwsScenarioError(const std::function<void()>& f, con
       return fail() << "is not a single line";
     if (what.find(path) == std::string::npos) return fail() << "does not name the path '" << path << "'";
     if (prefix ? e.path().rfind(path, 0) != 0 : e.path() != path)
-      return fail() << "path() is '" << e.path() << "', expected " << (prefix ? "it to start with " : "")
-                    << "'" << path << "'";
+      return fail() << "path() is '" << e.path() << "', expected " << (prefix ? "it to start with " : "") << "'" << path
+                    << "'";
     if (what.find("expected") == std::string::npos) return fail() << "does not say what was expected";
     if (!extra.empty() && what.find(extra) == std::string::npos) return fail() << "does not contain '" << extra << "'";
     return testing::AssertionSuccess();
@@ -123,10 +123,10 @@ testing::AssertionResult throwsScenarioError(const std::function<void()>& f, con
 }
 
 struct BadCase {
-  std::string name;   ///< test name suffix
-  std::string text;   ///< scenario JSON
-  std::string path;   ///< the JSON path (or byte position) the error must name
-  std::string extra;  ///< another text the message must contain ("" = none)
+  std::string name;     ///< test name suffix
+  std::string text;     ///< scenario JSON
+  std::string path;     ///< the JSON path (or byte position) the error must name
+  std::string extra;    ///< another text the message must contain ("" = none)
   bool prefix = false;  ///< path() only has to start with `path`
 };
 void PrintTo(const BadCase& c, std::ostream* os) { *os << c.name << ": " << c.text.substr(0, 200); }
@@ -213,8 +213,8 @@ const std::vector<BadCase> kTypeCases = {
     {"CenterThreeElements", R"({"field": {"center": [0, 0, 0]}})", "$.field.center", "an array of 2 numbers"},
     {"CenterNotArray", R"({"field": {"center": 0}})", "$.field.center", "an array of 2 numbers"},
     {"CenterElementString", R"({"field": {"center": [0, "x"]}})", "$.field.center[1]", "a number"},
-    {"InitialVelocityTwoElements", R"({"particles": {"initialVelocity": [0.2, 0.2]}})",
-     "$.particles.initialVelocity", "an array of 3 numbers"},
+    {"InitialVelocityTwoElements", R"({"particles": {"initialVelocity": [0.2, 0.2]}})", "$.particles.initialVelocity",
+     "an array of 3 numbers"},
     {"AccelerationNumber", R"({"particles": {"acceleration": 1}})", "$.particles.acceleration",
      "an array of 3 numbers"},
     {"AccelerationElementNull", R"({"particles": {"acceleration": [0, null, 0]}})", "$.particles.acceleration[1]",
@@ -249,8 +249,7 @@ const std::vector<BadCase> kValueCases = {
     {"PatchesXNonInteger", R"({"field": {"patchesX": 1.5}})", "$.field.patchesX", "an integer"},
     {"PatchesXString", R"({"field": {"patchesX": "151"}})", "$.field.patchesX", "an integer"},
     {"PatchesXHuge", R"({"field": {"patchesX": 1099511627776}})", "$.field.patchesX", "an integer"},
-    {"PatchesXAboveUint64", R"({"field": {"patchesX": 100000000000000000000000}})", "$.field.patchesX",
-     "an integer"},
+    {"PatchesXAboveUint64", R"({"field": {"patchesX": 100000000000000000000000}})", "$.field.patchesX", "an integer"},
     {"PatchesZZero", R"({"field": {"patchesZ": 0}})", "$.field.patchesZ", "an integer"},
     {"PatchesZJustAboveLimit", R"({"field": {"patchesZ": 1048577}})", "$.field.patchesZ", "an integer"},
     // particles
@@ -259,15 +258,11 @@ const std::vector<BadCase> kValueCases = {
     {"DampingNegative", R"({"particles": {"damping": -0.5}})", "$.particles.damping", ""},
     {"InterpolationFive", R"({"particles": {"interpolation": 5}})", "$.particles.interpolation", "an integer"},
     {"InterpolationZero", R"({"particles": {"interpolation": 0}})", "$.particles.interpolation", "an integer"},
-    {"InterpolationNonInteger", R"({"particles": {"interpolation": 1.5}})", "$.particles.interpolation",
-     "an integer"},
+    {"InterpolationNonInteger", R"({"particles": {"interpolation": 1.5}})", "$.particles.interpolation", "an integer"},
     {"MassZero", R"({"particles": {"mass": 0}})", "$.particles.mass", "positive"},
-    {"ConstraintLengthZero", R"({"particles": {"constraintLength": 0}})", "$.particles.constraintLength",
-     "positive"},
-    {"ConstraintModeUnknown", R"({"particles": {"constraintMode": "rigid"}})", "$.particles.constraintMode",
-     "\"pbd\""},
-    {"TiltDropDecreasing", R"({"particles": {"tiltDrop": [0.3, 0.2, 0.4]}})", "$.particles.tiltDrop[1]",
-     "increasing"},
+    {"ConstraintLengthZero", R"({"particles": {"constraintLength": 0}})", "$.particles.constraintLength", "positive"},
+    {"ConstraintModeUnknown", R"({"particles": {"constraintMode": "rigid"}})", "$.particles.constraintMode", "\"pbd\""},
+    {"TiltDropDecreasing", R"({"particles": {"tiltDrop": [0.3, 0.2, 0.4]}})", "$.particles.tiltDrop[1]", "increasing"},
     {"TiltDropEqual", R"({"particles": {"tiltDrop": [0.2, 0.3, 0.3]}})", "$.particles.tiltDrop[2]", "increasing"},
     {"TiltDropNegative", R"({"particles": {"tiltDrop": [-0.1, 0.3, 0.4]}})", "$.particles.tiltDrop[0]", ""},
     // time step
@@ -288,12 +283,11 @@ const std::vector<BadCase> kValueCases = {
     {"SpacingTooLarge", R"({"field": {"spacing": 1e37}})", "$.field.spacing", ""},
     {"SpacingStringTooLarge", R"({"field": {"spacing": "1e400"}})", "$.field.spacing", ""},
     {"SpacingHugeExponent", R"({"field": {"spacing": "1e99999999999999999999"}})", "$.field.spacing", ""},
-    {"TooManySignificantDigits", R"({"field": {"spacing": 0.1234567890123456789012345678901}})",
-     "$.field.spacing", "significant digits"},
+    {"TooManySignificantDigits", R"({"field": {"spacing": 0.1234567890123456789012345678901}})", "$.field.spacing",
+     "significant digits"},
     {"TooManyDigitsInteger", R"({"wind": {"travelSpeed": 1234567890123456789012345678901234567890}})",
      "$.wind.travelSpeed", ""},
-    {"TooManyDigitsInFraction", R"({"timeStep": "1/6000000000000000000000000000000000000000"})", "$.timeStep",
-     ""},
+    {"TooManyDigitsInFraction", R"({"timeStep": "1/6000000000000000000000000000000000000000"})", "$.timeStep", ""},
     // scalar and seed
     {"ScalarFx64", R"({"scalar": "fx64"})", "$.scalar", "\"fx16\""},
     {"ScalarUpperCase", R"({"scalar": "FX32"})", "$.scalar", ""},
@@ -349,12 +343,10 @@ const std::vector<BadCase> kHeightmapFileCases = {
     // The file name is quoted in the message: an escaped newline in it must not make two lines.
     {"FileNameWithNewline", heightmapTerrain("a\\nb.png"), "$.terrain.file", "PNG"},
 };
-INSTANTIATE_TEST_SUITE_P(ScenarioHeightmapFile, ScenarioParseError, testing::ValuesIn(kHeightmapFileCases),
-                         caseName);
+INSTANTIATE_TEST_SUITE_P(ScenarioHeightmapFile, ScenarioParseError, testing::ValuesIn(kHeightmapFileCases), caseName);
 
 TEST(ScenarioParse, NoReaderMeansHeightmapCannotBeRead) {
-  EXPECT_TRUE(throwsScenarioError([] { parseScenario(heightmapTerrain("gray4x3.png"), kFile, {}); },
-                                  "$.terrain.file"));
+  EXPECT_TRUE(throwsScenarioError([] { parseScenario(heightmapTerrain("gray4x3.png"), kFile, {}); }, "$.terrain.file"));
 }
 
 TEST(ScenarioParse, ReaderErrorTextIsInTheMessage) {
@@ -362,8 +354,8 @@ TEST(ScenarioParse, ReaderErrorTextIsInTheMessage) {
     *error = "a readable file, 'h.png': Permission denied";
     return false;
   };
-  EXPECT_TRUE(throwsScenarioError([&] { parseScenario(heightmapTerrain("h.png"), kFile, reader); },
-                                  "$.terrain.file", "Permission denied"));
+  EXPECT_TRUE(throwsScenarioError([&] { parseScenario(heightmapTerrain("h.png"), kFile, reader); }, "$.terrain.file",
+                                  "Permission denied"));
 }
 
 // ---- accepted boundaries (the rejections above are not over-eager) ----------------------------
@@ -419,7 +411,7 @@ const ScalarKind kAllScalars[] = {ScalarKind::Fx32, ScalarKind::Fx16, ScalarKind
 struct ScalarCase {
   std::string name;
   std::string text;
-  std::string path;                   ///< the path every rejecting scalar must name
+  std::string path;                    ///< the path every rejecting scalar must name
   std::vector<ScalarKind> rejectedBy;  ///< the others must accept it
   bool namesScalar = true;             ///< the message names the rejecting scalar
 };
@@ -445,44 +437,63 @@ TEST_P(ScenarioScalarRange, RejectedExactlyByScalarsThatCannotHoldIt) {
 
 const std::vector<ScalarCase> kScalarCases = {
     // 100 patches 1000 m apart reach 51 km from the centre: beyond fx16's 8 km, inside fx32's.
-    {"FieldBeyondFx16", R"({"field": {"patchesX": 100, "patchesZ": 100, "spacing": 1000}})", "$.field.patchesX",
+    {"FieldBeyondFx16",
+     R"({"field": {"patchesX": 100, "patchesZ": 100, "spacing": 1000}})",
+     "$.field.patchesX",
      {ScalarKind::Fx16}},
-    {"FieldBeyondFx16AlongZ", R"({"field": {"patchesX": 10, "patchesZ": 100, "spacing": 1000}})",
-     "$.field.patchesZ", {ScalarKind::Fx16}},
-    {"FieldBeyondFx32", R"({"field": {"patchesX": 1048576, "patchesZ": 1, "spacing": 2000}})", "$.field.patchesX",
+    {"FieldBeyondFx16AlongZ",
+     R"({"field": {"patchesX": 10, "patchesZ": 100, "spacing": 1000}})",
+     "$.field.patchesZ",
+     {ScalarKind::Fx16}},
+    {"FieldBeyondFx32",
+     R"({"field": {"patchesX": 1048576, "patchesZ": 1, "spacing": 2000}})",
+     "$.field.patchesX",
      {ScalarKind::Fx32, ScalarKind::Fx16}},
     {"SpacingRoundsToZeroInFx16", R"({"field": {"spacing": 1e-6}})", "$.field.spacing", {ScalarKind::Fx16}},
-    {"ConstraintLengthRoundsToZeroInFx16", R"({"particles": {"constraintLength": 1e-6}})",
-     "$.particles.constraintLength", {ScalarKind::Fx16}},
-    {"TravelSpeedRoundsToZeroInFx16", R"({"wind": {"travelSpeed": 1e-6}})", "$.wind.travelSpeed",
+    {"ConstraintLengthRoundsToZeroInFx16",
+     R"({"particles": {"constraintLength": 1e-6}})",
+     "$.particles.constraintLength",
      {ScalarKind::Fx16}},
-    {"PerTickDampingRoundsToZeroInFx16", R"({"timeStep": 1, "particles": {"damping": 1e-6}})",
-     "$.particles.damping", {ScalarKind::Fx16}},
+    {"TravelSpeedRoundsToZeroInFx16", R"({"wind": {"travelSpeed": 1e-6}})", "$.wind.travelSpeed", {ScalarKind::Fx16}},
+    {"PerTickDampingRoundsToZeroInFx16",
+     R"({"timeStep": 1, "particles": {"damping": 1e-6}})",
+     "$.particles.damping",
+     {ScalarKind::Fx16}},
     {"FlatHeightBeyondFx16", R"({"terrain": {"height": 10000}})", "$.terrain.height", {ScalarKind::Fx16}},
-    {"ForceBeyondFx16", R"({"wind": {"schedule": [{"force": [0, 10000, 0], "duration": 1}]}})",
-     "$.wind.schedule[0].force[1]", {ScalarKind::Fx16}},
+    {"ForceBeyondFx16",
+     R"({"wind": {"schedule": [{"force": [0, 10000, 0], "duration": 1}]}})",
+     "$.wind.schedule[0].force[1]",
+     {ScalarKind::Fx16}},
     {"ForceBeyondFx32",
      R"({"wind": {"schedule": [{"force": [0, 0, 0], "duration": 1}, {"force": [1e10, 0, 0], "duration": 1}]}})",
-     "$.wind.schedule[1].force[0]", {ScalarKind::Fx32, ScalarKind::Fx16}},
+     "$.wind.schedule[1].force[0]",
+     {ScalarKind::Fx32, ScalarKind::Fx16}},
     {"HeightmapMaxHeightBeyondFx16",
-     R"({"terrain": {"type": "heightmap", "file": "gray4x3.png", "maxHeight": 10000}})", "$.terrain.maxHeight",
+     R"({"terrain": {"type": "heightmap", "file": "gray4x3.png", "maxHeight": 10000}})",
+     "$.terrain.maxHeight",
      {ScalarKind::Fx16}},
     {"HeightmapCellSizeBeyondFx16",
-     R"({"terrain": {"type": "heightmap", "file": "gray4x3.png", "cellSize": 10000}})", "$.terrain.cellSize",
+     R"({"terrain": {"type": "heightmap", "file": "gray4x3.png", "cellSize": 10000}})",
+     "$.terrain.cellSize",
      {ScalarKind::Fx16}},
     // Gusts shorter than one tick (1/60 s) cannot be scheduled, for any scalar.
-    {"GustShorterThanOneTick", R"({"wind": {"schedule": [{"force": [0, 1, 0], "duration": 0.001}]}})",
-     "$.wind.schedule[0].duration", {ScalarKind::Fx32, ScalarKind::Fx16, ScalarKind::Float, ScalarKind::Double},
+    {"GustShorterThanOneTick",
+     R"({"wind": {"schedule": [{"force": [0, 1, 0], "duration": 0.001}]}})",
+     "$.wind.schedule[0].duration",
+     {ScalarKind::Fx32, ScalarKind::Fx16, ScalarKind::Float, ScalarKind::Double},
      false},
     // 0.01 s is 0.6 of a 1/60 s tick: shorter than one time step, even though it rounds to one tick.
-    {"GustOfSixTenthsOfATick", R"({"wind": {"schedule": [{"force": [0, 1, 0], "duration": 0.01}]}})",
-     "$.wind.schedule[0].duration", {ScalarKind::Fx32, ScalarKind::Fx16, ScalarKind::Float, ScalarKind::Double},
+    {"GustOfSixTenthsOfATick",
+     R"({"wind": {"schedule": [{"force": [0, 1, 0], "duration": 0.01}]}})",
+     "$.wind.schedule[0].duration",
+     {ScalarKind::Fx32, ScalarKind::Fx16, ScalarKind::Float, ScalarKind::Double},
      false},
     {"ThirdGustShorterThanOneTick",
      R"({"timeStep": 0.5, "wind": {"schedule": [{"force": [0, 1, 0], "duration": 1},
                                                 {"force": [0, 0, 0], "duration": 1},
                                                 {"force": [0, 1, 0], "duration": 0.2}]}})",
-     "$.wind.schedule[2].duration", {ScalarKind::Fx32, ScalarKind::Fx16, ScalarKind::Float, ScalarKind::Double},
+     "$.wind.schedule[2].duration",
+     {ScalarKind::Fx32, ScalarKind::Fx16, ScalarKind::Float, ScalarKind::Double},
      false},
     {"NothingWrong", R"({"field": {"patchesX": 10, "patchesZ": 10, "spacing": 100}})", "", {}},
 };
@@ -491,8 +502,7 @@ INSTANTIATE_TEST_SUITE_P(ScenarioScalar, ScenarioScalarRange, testing::ValuesIn(
 TEST(ScenarioMemory, SmallLimitRejectsTheField) {
   const Scenario s = parse("{}");
   for (ScalarKind k : kAllScalars) {
-    EXPECT_TRUE(throwsScenarioError([&] { validateForScalar(s, k, 1024); }, "$.field", "memory"))
-        << scalarName(k);
+    EXPECT_TRUE(throwsScenarioError([&] { validateForScalar(s, k, 1024); }, "$.field", "memory")) << scalarName(k);
     EXPECT_NO_THROW(validateForScalar(s, k, 0)) << "0 = unlimited, " << scalarName(k);
   }
 }
@@ -564,20 +574,29 @@ TEST_P(ScenarioWorldRange, MakeWorldRejectsValuesOutsideTheScalar) {
 const std::vector<WorldRangeCase> kWorldRangeCases = {
     {"AccelerationBeyondFx32",
      R"({"field": {"patchesX": 4, "patchesZ": 4}, "particles": {"acceleration": [0, 1e20, 0]}})",
-     ScalarKind::Fx32, {"$.particles.acceleration"}},
+     ScalarKind::Fx32,
+     {"$.particles.acceleration"}},
     {"AccelerationBeyondFx16",
      R"({"field": {"patchesX": 4, "patchesZ": 4}, "particles": {"acceleration": [0, 40000, 0]}})",
-     ScalarKind::Fx16, {"$.particles.acceleration"}},
+     ScalarKind::Fx16,
+     {"$.particles.acceleration"}},
     {"InitialVelocityBeyondFx32",
-     R"({"field": {"patchesX": 4, "patchesZ": 4}, "particles": {"initialVelocity": [1e20, 0, 0]}})", ScalarKind::Fx32,
+     R"({"field": {"patchesX": 4, "patchesZ": 4}, "particles": {"initialVelocity": [1e20, 0, 0]}})",
+     ScalarKind::Fx32,
      {"$.particles.initialVelocity"}},
-    {"TiltDropBeyondFx32", R"({"field": {"patchesX": 4, "patchesZ": 4}, "particles": {"tiltDrop": [0.2, 0.3, 1e20]}})",
-     ScalarKind::Fx32, {"$.particles.tiltDrop"}},
-    {"ForcePerMassBeyondFx32", R"({"field": {"patchesX": 4, "patchesZ": 4}, "particles": {"mass": 1e-20}})",
-     ScalarKind::Fx32, {"$.particles.mass", "$.wind.schedule["}},
+    {"TiltDropBeyondFx32",
+     R"({"field": {"patchesX": 4, "patchesZ": 4}, "particles": {"tiltDrop": [0.2, 0.3, 1e20]}})",
+     ScalarKind::Fx32,
+     {"$.particles.tiltDrop"}},
+    {"ForcePerMassBeyondFx32",
+     R"({"field": {"patchesX": 4, "patchesZ": 4}, "particles": {"mass": 1e-20}})",
+     ScalarKind::Fx32,
+     {"$.particles.mass", "$.wind.schedule["}},
     // 1/dt = 50000 does not fit Q16.16 (max 32767.99).
-    {"InverseTimeStepBeyondFx16", R"({"field": {"patchesX": 4, "patchesZ": 4}, "timeStep": "1/50000"})",
-     ScalarKind::Fx16, {"$.timeStep"}},
+    {"InverseTimeStepBeyondFx16",
+     R"({"field": {"patchesX": 4, "patchesZ": 4}, "timeStep": "1/50000"})",
+     ScalarKind::Fx16,
+     {"$.timeStep"}},
 };
 INSTANTIATE_TEST_SUITE_P(ScenarioWorld, ScenarioWorldRange, testing::ValuesIn(kWorldRangeCases), worldCaseName);
 
@@ -648,19 +667,22 @@ std::vector<LongCase> longCases(const Decimals& n) {
                speed = std::stod(n.speed);
   const std::string small = R"("field": {"patchesX": 4, "patchesZ": 4)";
   return {
-      {n.tag + "JitterTimesSpacing", "{" + small + R"(, "spacing": )" + n.a + R"(, "jitter": )" + n.jitter + "}}",
+      {n.tag + "JitterTimesSpacing",
+       "{" + small + R"(, "spacing": )" + n.a + R"(, "jitter": )" + n.jitter + "}}",
        {"$.field.spacing", "$.field.jitter"},
        [=](const World<Fx32>& w) { return mismatch("jitterAmplitude", fx(w.lattice().jitterAmplitude), a * jitter); }},
       {n.tag + "CenterMinusHalfTheField",
        "{" + small + R"(, "spacing": )" + n.a + R"(, "center": [)" + n.b + ", 0]}}",
        {"$.field.spacing", "$.field.center"},
        [=](const World<Fx32>& w) { return mismatch("originX", fx(w.lattice().originX), b - 1.5 * a); }},
-      {n.tag + "Damping", "{" + small + R"(}, "particles": {"damping": )" + n.b + "}}",
+      {n.tag + "Damping",
+       "{" + small + R"(}, "particles": {"damping": )" + n.b + "}}",
        {"$.particles.damping"},
        [=](const World<Fx32>& w) {
          return mismatch("dampingPerTick", fx(w.particleConstants().dampingPerTick), std::pow(b, 1.0 / 60));
        }},
-      {n.tag + "TimeStep", "{" + small + R"(}, "timeStep": ")" + n.dt + "\"}",
+      {n.tag + "TimeStep",
+       "{" + small + R"(}, "timeStep": ")" + n.dt + "\"}",
        {"$.timeStep"},
        [=](const World<Fx32>& w) {
          const std::string m = mismatch("dt", fx(w.particleConstants().dt), dt);

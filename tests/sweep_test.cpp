@@ -145,10 +145,26 @@ const char* kTinyScenario = R"({"format": "simgrass-scenario/1", "name": "tiny-s
  "camera": [{"tick": 0, "position": [-1, 2, 0]}],
  "lod": {"mode": "off", "window": [15, 15]}})";
 
-const std::vector<std::string> kColumns{"scenario", "scalar", "k", "dt", "dt_s", "lod", "broadphase", "steps",
-                                        "ms_per_tick", "ms_per_simulated_second", "tip_rms_m", "tip_max_m",
-                                        "body_pos_max_m", "body_angle_max_rad", "first_divergent_time",
-                                        "states_compared", "status", "pareto", "pareto_tip_max", "pareto_body"};
+const std::vector<std::string> kColumns{"scenario",
+                                        "scalar",
+                                        "k",
+                                        "dt",
+                                        "dt_s",
+                                        "lod",
+                                        "broadphase",
+                                        "steps",
+                                        "ms_per_tick",
+                                        "ms_per_simulated_second",
+                                        "tip_rms_m",
+                                        "tip_max_m",
+                                        "body_pos_max_m",
+                                        "body_angle_max_rad",
+                                        "first_divergent_time",
+                                        "states_compared",
+                                        "status",
+                                        "pareto",
+                                        "pareto_tip_max",
+                                        "pareto_body"};
 
 std::vector<std::map<std::string, std::string>> readCsv(const std::string& path) {
   std::istringstream in(readFile(path));
@@ -181,7 +197,8 @@ class SweepCli : public testing::Test {
     scenario_ = dir_->write("tiny.json", kTinyScenario);
     result_ = new CliResult(runCli("sweep --scenarios " + quote(scenario_) +
                                    " --seconds 1 --scalars double,fx16 --k 1,2 --dt 1/60,1/240 --lod off "
-                                   "--repeats 2 --json --out " + quote(dir_->file("out"))));
+                                   "--repeats 2 --json --out " +
+                                   quote(dir_->file("out"))));
   }
   static void TearDownTestSuite() {
     delete result_;
@@ -200,7 +217,7 @@ TEST_F(SweepCli, OneRowPerVariantInCsvAndJson) {
   const json doc = parseJson(*result_);
   ASSERT_TRUE(doc.contains("rows"));
   const json& rows = doc["rows"];
-  ASSERT_EQ(rows.size(), 8u);  // 2 scalars x 2 k x 2 dt x 1 lod
+  ASSERT_EQ(rows.size(), 8u);                                           // 2 scalars x 2 k x 2 dt x 1 lod
   EXPECT_EQ(json::parse(readFile(dir_->file("out/sweep.json"))), doc);  // --json prints the file
   const auto csv = readCsv(dir_->file("out/sweep.csv"));
   ASSERT_EQ(csv.size(), rows.size());
@@ -315,8 +332,8 @@ TEST(SweepCliErrors, BadInputIsOneLineExit2) {
   const std::string scenario = dir.write("tiny.json", kTinyScenario);
   // A small valid sweep with one option replaced by a bad value.
   auto args = [&](const std::string& file, const std::string& option, const std::string& value) {
-    std::map<std::string, std::string> o{{"--seconds", "0.1"}, {"--scalars", "double"}, {"--k", "1"},
-                                         {"--dt", "1/60"},     {"--lod", "off"},        {"--repeats", "1"},
+    std::map<std::string, std::string> o{{"--seconds", "0.1"},      {"--scalars", "double"}, {"--k", "1"},
+                                         {"--dt", "1/60"},          {"--lod", "off"},        {"--repeats", "1"},
                                          {"--out", dir.file("out")}};
     o[option] = value;
     std::string line = "sweep --scenarios " + quote(file);
@@ -352,8 +369,8 @@ TEST(SweepCliErrors, BadInputIsOneLineExit2) {
 TEST(SweepCliErrors, HelpNamesTheOptions) {
   const CliResult r = runCli("sweep --help");
   EXPECT_EQ(r.exitCode, 0);
-  for (const char* opt : {"--scenarios", "--seconds", "--out", "--scalars", "--k", "--dt", "--lod", "--repeats",
-                          "--threads", "--json"})
+  for (const char* opt :
+       {"--scenarios", "--seconds", "--out", "--scalars", "--k", "--dt", "--lod", "--repeats", "--threads", "--json"})
     EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
 }
 

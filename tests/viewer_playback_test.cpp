@@ -14,7 +14,7 @@
 
 namespace sg {
 namespace viewer_test {
-bool onPath(const std::string& program);                          // tests/viewer_test.cpp
+bool onPath(const std::string& program);                         // tests/viewer_test.cpp
 CliResult runViewer(const std::string& args, bool xvfb = true);  // tests/viewer_test.cpp
 }  // namespace viewer_test
 
@@ -114,8 +114,9 @@ TEST(ViewerPlayback, AbOfARecordingWithItselfIsZeroAndUnderAVariantMatchesCompar
   ASSERT_GT(worst, 0);
 
   // Step from 0 past compare's first divergent tick, then jump to its worst tick.
-  const std::string script = dir.write("ab.txt", "step " + std::to_string(first + 2) + "\nprint\nab overlay\nframes 1\n" +
-                                                     "seek " + std::to_string(worstTick) + "\nprint\nab side\nframes 1\nquit\n");
+  const std::string script =
+      dir.write("ab.txt", "step " + std::to_string(first + 2) + "\nprint\nab overlay\nframes 1\n" + "seek " +
+                              std::to_string(worstTick) + "\nprint\nab side\nframes 1\nquit\n");
   const CliResult self = runViewer(quote(rec) + " --ab " + quote(rec) + " --script " + quote(script) + kWindow);
   ASSERT_EQ(self.exitCode, 0) << self.describe();
   for (const StateLine& s : stateLines(self.out)) {
@@ -140,10 +141,11 @@ TEST(ViewerPlayback, SpawnResetAndMowerKeysRecordAReplayThatVerifies) {
   if (!onPath("xvfb-run")) GTEST_SKIP() << "xvfb-run is not on PATH";
   TempDir dir;
   const std::string out = dir.file("bodies.sgr");
-  const std::string script = dir.write("bodies.txt",
-                                       "record start " + out + "\nselect 0\nkey n down\nframes 1\nkey n up\nframes 4\n"
-                                       "print\nkey t down\nframes 5\nkey t up\nkey z down\nframes 1\nkey z up\n"
-                                       "key m down\nframes 1\nkey m up\nframes 3\nprint\nrecord stop\nquit\n");
+  const std::string script =
+      dir.write("bodies.txt", "record start " + out +
+                                  "\nselect 0\nkey n down\nframes 1\nkey n up\nframes 4\n"
+                                  "print\nkey t down\nframes 5\nkey t up\nkey z down\nframes 1\nkey z up\n"
+                                  "key m down\nframes 1\nkey m up\nframes 3\nprint\nrecord stop\nquit\n");
   const std::string scenario = test::sourcePath("scenarios/mower-field.json");
   const CliResult v = runViewer(quote(scenario) + " --script " + quote(script) + kWindow);
   ASSERT_EQ(v.exitCode, 0) << v.describe();
@@ -174,8 +176,10 @@ TEST(ViewerPlayback, RegenerateWithNewCountsAndLodToggle) {
   const std::string out = dir.file("regen.sgr");
   const std::string script = dir.write("regen.txt",
                                        "frames 2\nprint\nset field.patchesX 41\nset field.patchesZ 31\nregenerate\n"
-                                       "print\nrecord start " + out + "\nframes 4\nrecord stop\nlod on\nprint\n"
-                                       "set field.spacing -1\nregenerate\nframes 1\nprint\nquit\n");
+                                       "print\nrecord start " +
+                                           out +
+                                           "\nframes 4\nrecord stop\nlod on\nprint\n"
+                                           "set field.spacing -1\nregenerate\nframes 1\nprint\nquit\n");
   const CliResult v = runViewer("--script " + quote(script) + kWindow);
   ASSERT_EQ(v.exitCode, 0) << v.describe();
   const std::vector<StateLine> s = stateLines(v.out);

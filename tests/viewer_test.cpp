@@ -23,7 +23,8 @@ CliResult runViewer(const std::string& args, bool xvfb = true) {
   const std::string out = dir.file("stdout"), err = dir.file("stderr");
   // xvfb-run's own temporary folder (X authority file) goes into this test's folder: in the
   // shared /tmp another process's clean-up could remove it first and fail the run (exit 5).
-  const std::string prefix = xvfb ? "env TMPDIR=" + quote(dir.file("")) + " xvfb-run -a -s '-screen 0 1024x768x24' " : "";
+  const std::string prefix =
+      xvfb ? "env TMPDIR=" + quote(dir.file("")) + " xvfb-run -a -s '-screen 0 1024x768x24' " : "";
   const std::string cmd = "timeout -k 5 120 " + prefix + quote(SIMGRASS_VIEWER) + " " + args + " </dev/null >" +
                           quote(out) + " 2>" + quote(err);
   // xvfb-run sometimes fails its own clean-up after a viewer that exits within a fraction of a
@@ -39,8 +40,10 @@ CliResult runViewer(const std::string& args, bool xvfb = true) {
   for (int attempt = 0; attempt < 3; ++attempt) {
     const int status = std::system(cmd.c_str());
     r = CliResult{};
-    if (status != -1 && WIFEXITED(status)) r.exitCode = WEXITSTATUS(status);
-    else if (status != -1 && WIFSIGNALED(status)) r.exitCode = 128 + WTERMSIG(status);
+    if (status != -1 && WIFEXITED(status))
+      r.exitCode = WEXITSTATUS(status);
+    else if (status != -1 && WIFSIGNALED(status))
+      r.exitCode = 128 + WTERMSIG(status);
     r.out = readFile(out);
     r.err = readFile(err);
     const bool harnessFailed = (xvfb && r.exitCode == 5 && r.err.find(cleanupNoise) != std::string::npos) ||
@@ -69,17 +72,23 @@ TEST(Viewer, ScriptedSessionRecordsAReplayThatVerifies) {
   const std::string recording = dir.file("session.sgr");
   const std::string script = dir.write("drive.txt",
                                        "# drive the football forward, then right, in velocity mode\n"
-                                       "record start " + recording + "\n"
-                                       "select 0\n"
-                                       "key t down\n"
-                                       "frames " + std::to_string(half) + "\n"
-                                       "key t up\n"
-                                       "key h down\n"
-                                       "key w down\n"
-                                       "frames " + std::to_string(half) + "\n"
-                                       "key h up\n"
-                                       "record stop\n"
-                                       "quit\n");
+                                       "record start " +
+                                           recording +
+                                           "\n"
+                                           "select 0\n"
+                                           "key t down\n"
+                                           "frames " +
+                                           std::to_string(half) +
+                                           "\n"
+                                           "key t up\n"
+                                           "key h down\n"
+                                           "key w down\n"
+                                           "frames " +
+                                           std::to_string(half) +
+                                           "\n"
+                                           "key h up\n"
+                                           "record stop\n"
+                                           "quit\n");
   const std::string scenario = std::string(SIMGRASS_SOURCE_DIR) + "/scenarios/thesis-bodies.json";
   const CliResult v = runViewer(quote(scenario) + " --script " + quote(script) + " --size 320x240 --msaa 0");
   ASSERT_EQ(v.exitCode, 0) << v.describe();
@@ -89,8 +98,7 @@ TEST(Viewer, ScriptedSessionRecordsAReplayThatVerifies) {
 
   const CliResult verify = runCli("replay " + quote(recording) + " --verify");
   ASSERT_EQ(verify.exitCode, 0) << verify.describe();
-  EXPECT_NE(verify.out.find("verified " + std::to_string(2 * half) + " ticks"), std::string::npos)
-      << verify.describe();
+  EXPECT_NE(verify.out.find("verified " + std::to_string(2 * half) + " ticks"), std::string::npos) << verify.describe();
 
   const CliResult replay = runCli("replay " + quote(recording) + " --json");
   ASSERT_EQ(replay.exitCode, 0) << replay.describe();
@@ -100,8 +108,8 @@ TEST(Viewer, ScriptedSessionRecordsAReplayThatVerifies) {
 
   // The football was driven: the session differs from one with the same camera and no keys.
   const std::string idle = dir.file("idle.sgr");
-  const std::string idleScript = dir.write("idle.txt", "record start " + idle + "\nkey w down\nframes " +
-                                                           std::to_string(2 * half) + "\nquit\n");
+  const std::string idleScript =
+      dir.write("idle.txt", "record start " + idle + "\nkey w down\nframes " + std::to_string(2 * half) + "\nquit\n");
   const CliResult i = runViewer(quote(scenario) + " --script " + quote(idleScript) + " --size 320x240 --msaa 0");
   ASSERT_EQ(i.exitCode, 0) << i.describe();
   EXPECT_NE(recordedHash(i.out), hash) << "the drive keys changed nothing";

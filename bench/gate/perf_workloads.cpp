@@ -27,8 +27,8 @@
 #include <string>
 #include <vector>
 
-#include "replay/kernel_environment.h"
 #include "replay/format/sgr_reader.h"
+#include "replay/kernel_environment.h"
 #include "replay/player.h"
 #include "replay/recorder.h"
 #include "replay/scenario_files.h"
@@ -76,7 +76,8 @@ std::function<Outcome()> stepping(std::shared_ptr<sg::SimWorld> world, sg::Scena
     if (c.lodWindow)
       o.note = "window moved " + std::to_string(c.windowOriginI - originI) + " columns, " +
                std::to_string(c.windowOriginJ - originJ) + " rows";
-    if (c.bodies > 0) o.note += (o.note.empty() ? "" : ", ") + std::to_string(c.contacts) + " contacts in the last tick";
+    if (c.bodies > 0)
+      o.note += (o.note.empty() ? "" : ", ") + std::to_string(c.contacts) + " contacts in the last tick";
     return o;
   };
 }
@@ -96,7 +97,8 @@ std::function<Outcome()> runScalarKernel(const sg::Scenario& s, int64_t ticks) {
 const std::vector<Workload>& workloads() {
   using sg::ScalarKind;
   static const std::vector<Workload> list = {
-      {"meadow-fx32-k1", "thesis meadow (22,801 patches), fx32, k=1: 20 ticks (wind, integrate, constraints, patch state)",
+      {"meadow-fx32-k1",
+       "thesis meadow (22,801 patches), fx32, k=1: 20 ticks (wind, integrate, constraints, patch state)",
        [](const std::string&) { return run(builtInMeadow(ScalarKind::Fx32, 1), 20); }},
       {"meadow-fx32-k2", "thesis meadow, fx32, k=2 (interpolated patch state): 40 ticks",
        [](const std::string&) { return run(builtInMeadow(ScalarKind::Fx32, 2), 40); }},
@@ -110,7 +112,8 @@ const std::vector<Workload>& workloads() {
        [](const std::string& dir) { return run(sg::loadScenarioFile(dir + "/thesis-bodies.json"), 30); }},
       {"mower-fx32", "scenarios/mower-field.json (compound mower body, cutting): 40 ticks, past its push at tick 30",
        [](const std::string& dir) { return run(sg::loadScenarioFile(dir + "/mower-field.json"), 40); }},
-      {"lod-crossing", "scenarios/lod-crossing.json (121x121 window following the camera: window shifts, edge ring): 40 ticks",
+      {"lod-crossing",
+       "scenarios/lod-crossing.json (121x121 window following the camera: window shifts, edge ring): 40 ticks",
        [](const std::string& dir) { return run(sg::loadScenarioFile(dir + "/lod-crossing.json"), 40); }},
       {"record-fx32", "record the thesis meadow for 20 ticks to a temp file (CHCK hash every tick, SNAP every 10)",
        [](const std::string&) -> std::function<Outcome()> {
@@ -171,10 +174,11 @@ extern "C" __attribute__((noinline)) void simgrass_perf_measured(void* part, voi
 }
 
 int main(int argc, char** argv) {
-  CLI::App app{"Deterministic single-threaded workloads for the callgrind instruction-count gate (.ci/perf-gate).\n"
-               "Only the call to simgrass_perf_measured() is meant to be counted:\n"
-               "  valgrind --tool=callgrind --collect-atstart=no --toggle-collect=simgrass_perf_measured "
-               "simgrass_perf_workloads NAME"};
+  CLI::App app{
+      "Deterministic single-threaded workloads for the callgrind instruction-count gate (.ci/perf-gate).\n"
+      "Only the call to simgrass_perf_measured() is meant to be counted:\n"
+      "  valgrind --tool=callgrind --collect-atstart=no --toggle-collect=simgrass_perf_measured "
+      "simgrass_perf_workloads NAME"};
   std::string name;
   std::string scenarioDir = SIMGRASS_SCENARIO_DIR;
   bool list = false, json = false, info = false;
@@ -192,9 +196,10 @@ int main(int argc, char** argv) {
   if (info) {
     const char* kernel = sg::particleKernelName(sg::defaultParticleKernel());
     if (json)
-      std::printf("%s\n", nlohmann::json{{"buildId", sg::buildId()}, {"compiler", __VERSION__}, {"particleKernel", kernel}}
-                              .dump()
-                              .c_str());
+      std::printf("%s\n",
+                  nlohmann::json{{"buildId", sg::buildId()}, {"compiler", __VERSION__}, {"particleKernel", kernel}}
+                      .dump()
+                      .c_str());
     else
       std::printf("%s (compiler %s, %s particle kernel)\n", sg::buildId().c_str(), __VERSION__, kernel);
     return 0;
@@ -202,8 +207,10 @@ int main(int argc, char** argv) {
   if (list) {
     nlohmann::json all = nlohmann::json::array();
     for (const Workload& w : workloads()) {
-      if (json) all.push_back({{"name", w.name}, {"what", w.what}});
-      else std::printf("%-20s %s\n", w.name, w.what);
+      if (json)
+        all.push_back({{"name", w.name}, {"what", w.what}});
+      else
+        std::printf("%-20s %s\n", w.name, w.what);
     }
     if (json) std::printf("%s\n", all.dump().c_str());
     return 0;
@@ -212,7 +219,8 @@ int main(int argc, char** argv) {
   for (const Workload& w : workloads())
     if (name == w.name) chosen = &w;
   if (!chosen) {
-    std::fprintf(stderr, "simgrass_perf_workloads: workload '%s': expected one of the names --list prints\n", name.c_str());
+    std::fprintf(stderr, "simgrass_perf_workloads: workload '%s': expected one of the names --list prints\n",
+                 name.c_str());
     return 2;
   }
   Outcome outcome;
@@ -224,8 +232,14 @@ int main(int argc, char** argv) {
     char hash[19];
     std::snprintf(hash, sizeof hash, "%016" PRIx64, outcome.hash);
     if (json)
-      std::printf("%s\n", nlohmann::json{{"workload", chosen->name}, {"ok", outcome.ok}, {"ticks", outcome.ticks},
-                                         {"hash", hash}, {"note", outcome.note}, {"seconds", seconds}}.dump().c_str());
+      std::printf("%s\n", nlohmann::json{{"workload", chosen->name},
+                                         {"ok", outcome.ok},
+                                         {"ticks", outcome.ticks},
+                                         {"hash", hash},
+                                         {"note", outcome.note},
+                                         {"seconds", seconds}}
+                              .dump()
+                              .c_str());
     else
       std::printf("%s: %" PRId64 " ticks, hash %s, %.3f s measured%s%s%s\n", chosen->name, outcome.ticks, hash, seconds,
                   outcome.note.empty() ? "" : " (", outcome.note.c_str(), outcome.note.empty() ? "" : ")");

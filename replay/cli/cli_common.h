@@ -18,9 +18,9 @@ inline std::string hex(uint64_t h) {
 /// Exit codes shared by the commands.
 enum ExitCode : int {
   kExitOk = 0,
-  kExitMismatch = 1,    ///< a simulation fault, a hash mismatch, a variant that had to be identical
-  kExitBadInput = 2,    ///< bad command line, scenario, recording or input track
-  kExitTruncated = 3,   ///< a recording cut off before END: everything in it checked out
+  kExitMismatch = 1,   ///< a simulation fault, a hash mismatch, a variant that had to be identical
+  kExitBadInput = 2,   ///< bad command line, scenario, recording or input track
+  kExitTruncated = 3,  ///< a recording cut off before END: everything in it checked out
 };
 
 }  // namespace sg

@@ -26,9 +26,9 @@ struct CompareOptions {
 
 /// One --variant: what it changes and what it measured.
 struct Row {
-  std::string name;          ///< the settings it changes ("scalar=fx16 interp=2")
+  std::string name;  ///< the settings it changes ("scalar=fx16 interp=2")
   VariantSettings settings;
-  std::string resolved;      ///< every setting of the run
+  std::string resolved;  ///< every setting of the run
   bool mustBeIdentical = false;
   int64_t recordedTicksPerStep = 1, substeps = 1;
   DivergenceSummary summary;
@@ -36,9 +36,7 @@ struct Row {
   std::vector<TickDivergence> series;
   std::optional<SimError> fault;
 
-  int64_t firstDivergentTick() const {
-    return mustBeIdentical ? summary.firstHashTick : summary.firstObservedTick;
-  }
+  int64_t firstDivergentTick() const { return mustBeIdentical ? summary.firstHashTick : summary.firstObservedTick; }
   bool failed() const { return fault || (mustBeIdentical && summary.firstHashTick >= 0); }
   std::string status() const {
     if (fault) return "FAULT: " + fault->message();
@@ -64,11 +62,13 @@ int compare(const CompareOptions& o) {
   if (!rec) return kExitBadInput;
   const int64_t last = rec->lastTick();
   if (last < 1) {
-    std::fprintf(stderr, "simgrass compare: %s: expected a recording of at least one tick, it holds none\n", o.file.c_str());
+    std::fprintf(stderr, "simgrass compare: %s: expected a recording of at least one tick, it holds none\n",
+                 o.file.c_str());
     return kExitBadInput;
   }
   if (o.ticks > last) {
-    std::fprintf(stderr, "simgrass compare: --ticks: expected 1 to %" PRId64 " (the recording's last tick), got %" PRId64 "\n",
+    std::fprintf(stderr,
+                 "simgrass compare: --ticks: expected 1 to %" PRId64 " (the recording's last tick), got %" PRId64 "\n",
                  last, o.ticks);
     return kExitBadInput;
   }
@@ -207,12 +207,13 @@ int compare(const CompareOptions& o) {
         std::fprintf(f, "reference,%s,1,%s,%s,0,0,0,0,0,-1,hash,%" PRId64 "\n", csvField(recorded.describe()).c_str(),
                      ref.firstMismatchTick >= 0 ? "not-verified" : "verified", csvNumber(refMs).c_str(), ticks + 1);
         for (const Row& r : rows)
-          std::fprintf(f, "%s,%s,%d,%s,%s,%s,%s,%s,%s,%" PRId64 ",%" PRId64 ",%s,%" PRId64 "\n", csvField(r.name).c_str(),
-                       csvField(r.resolved).c_str(), r.mustBeIdentical ? 1 : 0, csvField(r.status()).c_str(),
-                       csvNumber(medianOf(r.msPerTick)).c_str(), csvNumber(r.summary.tipMax).c_str(),
-                       csvNumber(r.summary.tipRms()).c_str(), csvNumber(r.summary.bodyPosMax).c_str(),
-                       csvNumber(r.summary.bodyAngleMax).c_str(), r.summary.contactDeltaMax, r.firstDivergentTick(),
-                       r.mustBeIdentical ? "hash" : "observation", r.summary.ticks);
+          std::fprintf(f, "%s,%s,%d,%s,%s,%s,%s,%s,%s,%" PRId64 ",%" PRId64 ",%s,%" PRId64 "\n",
+                       csvField(r.name).c_str(), csvField(r.resolved).c_str(), r.mustBeIdentical ? 1 : 0,
+                       csvField(r.status()).c_str(), csvNumber(medianOf(r.msPerTick)).c_str(),
+                       csvNumber(r.summary.tipMax).c_str(), csvNumber(r.summary.tipRms()).c_str(),
+                       csvNumber(r.summary.bodyPosMax).c_str(), csvNumber(r.summary.bodyAngleMax).c_str(),
+                       r.summary.contactDeltaMax, r.firstDivergentTick(), r.mustBeIdentical ? "hash" : "observation",
+                       r.summary.ticks);
       }))
     return kExitBadInput;
   if (!o.series.empty() && !writeCsv("compare", o.series, std::string("variant,") + kTickCsvColumns, [&](std::FILE* f) {
@@ -259,7 +260,8 @@ int compare(const CompareOptions& o) {
     out["ok"] = code == kExitOk;
     std::printf("%s\n", out.dump(2).c_str());
   } else {
-    std::printf("recording  %s: %s, ticks 0 to %" PRId64 "\n", o.file.c_str(), rec->header.scenarioSource.c_str(), ticks);
+    std::printf("recording  %s: %s, ticks 0 to %" PRId64 "\n", o.file.c_str(), rec->header.scenarioSource.c_str(),
+                ticks);
     std::printf("reference  %s: %.3f ms/tick, %s\n\n", recorded.describe().c_str(), refMs, refVerified.c_str());
     size_t w = 7;
     for (const Row& r : rows) w = std::max(w, r.name.size());
@@ -267,17 +269,17 @@ int compare(const CompareOptions& o) {
                 "tip rms m", "body pos m", "body rad", "contacts", "diverges", "status");
     for (const Row& r : rows) {
       const int64_t first = r.firstDivergentTick();
-      const std::string diverges =
-          first < 0 ? "never" : std::to_string(first) + (r.mustBeIdentical ? " (h)" : " (o)");
+      const std::string diverges = first < 0 ? "never" : std::to_string(first) + (r.mustBeIdentical ? " (h)" : " (o)");
       std::printf("%-*s  %8.3f  %11s  %11s  %11s  %11s  %8" PRId64 "  %9s  %s\n", int(w), r.name.c_str(),
                   medianOf(r.msPerTick), shortNumber(r.summary.tipMax).c_str(), shortNumber(r.summary.tipRms()).c_str(),
                   shortNumber(r.summary.bodyPosMax).c_str(), shortNumber(r.summary.bodyAngleMax).c_str(),
                   r.summary.contactDeltaMax, diverges.c_str(), r.status().c_str());
     }
-    std::printf("\nms/tick: median wall time to advance one recorded tick (%s); errors: largest over the ticks "
-                "compared, rms over all patches and ticks; contacts: largest |reference - variant|; diverges: first "
-                "tick whose state hash (h) or whose tips, bodies or contacts (o) differ.\n",
-                o.threads == 1 ? "1 thread" : (std::to_string(o.threads) + " threads").c_str());
+    std::printf(
+        "\nms/tick: median wall time to advance one recorded tick (%s); errors: largest over the ticks "
+        "compared, rms over all patches and ticks; contacts: largest |reference - variant|; diverges: first "
+        "tick whose state hash (h) or whose tips, bodies or contacts (o) differ.\n",
+        o.threads == 1 ? "1 thread" : (std::to_string(o.threads) + " threads").c_str());
   }
   return code;
 }
@@ -286,7 +288,8 @@ int compare(const CompareOptions& o) {
 void addCompareCommand(CLI::App& app, int* exitCode) {
   auto o = std::make_shared<CompareOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "compare", "Replay a recording's inputs under variant settings: ms/tick, tip and body error, first divergent tick");
+      "compare",
+      "Replay a recording's inputs under variant settings: ms/tick, tip and body error, first divergent tick");
   cmd->add_option("recording", o->file, "Recording (.sgr): its own settings are the reference")->required();
   cmd->add_option("--variant", o->variants,
                   "One variant row: scalar=fx16, interp=2, broadphase=brute, body-broadphase=sap, dt=1/120, threads=2; "
@@ -300,9 +303,10 @@ void addCompareCommand(CLI::App& app, int* exitCode) {
   cmd->add_option("--csv", o->csv, "Write one row per variant (the reference first) to this CSV file");
   cmd->add_option("--series", o->series, "Write one row per variant and compared tick to this CSV file");
   cmd->add_flag("--json", o->json, "Machine-readable output");
-  cmd->footer("Variants that cannot change the state (broad phases, threads) must be bit-identical to the reference. "
-              "Exit codes: 0 ok, 1 such a variant was not identical, a run faulted or the reference left the "
-              "recording, 2 bad input.");
+  cmd->footer(
+      "Variants that cannot change the state (broad phases, threads) must be bit-identical to the reference. "
+      "Exit codes: 0 ok, 1 such a variant was not identical, a run faulted or the reference left the "
+      "recording, 2 bad input.");
   cmd->callback([o, exitCode] { *exitCode = compare(*o); });
 }
 }  // namespace sg

@@ -95,8 +95,10 @@ int diff(const DiffOptions& o) {
     const Rational dtA = recordedTimeStep(*a.rec), dtB = recordedTimeStep(*b.rec);
     const std::optional<TimeRatio> ratio = lineUp(dtA, dtB);
     if (!ratio) {
-      std::fprintf(stderr, "simgrass diff: %s: expected a time step that is a whole multiple or fraction of %s's dt=%s, got dt=%s\n",
-                   o.b.c_str(), o.a.c_str(), dtA.toString().c_str(), dtB.toString().c_str());
+      std::fprintf(
+          stderr,
+          "simgrass diff: %s: expected a time step that is a whole multiple or fraction of %s's dt=%s, got dt=%s\n",
+          o.b.c_str(), o.a.c_str(), dtA.toString().c_str(), dtB.toString().c_str());
       return kExitBadInput;
     }
     a.ticksPerStep = ratio->aSteps, b.ticksPerStep = ratio->bSteps;
@@ -110,8 +112,9 @@ int diff(const DiffOptions& o) {
   b.hashes = std::make_unique<RecordedHashes>(*b.rec);
   const WorldCounts ca = a.run->world().counts(), cb = b.run->world().counts();
   if (ca.patchesX != cb.patchesX || ca.patchesZ != cb.patchesZ || ca.bodies != cb.bodies) {
-    std::fprintf(stderr, "simgrass diff: %s: expected a recording of a field like %s's (%" PRId64 " x %" PRId64
-                         " patches, %" PRId64 " bodies), got %" PRId64 " x %" PRId64 " patches, %" PRId64 " bodies\n",
+    std::fprintf(stderr,
+                 "simgrass diff: %s: expected a recording of a field like %s's (%" PRId64 " x %" PRId64
+                 " patches, %" PRId64 " bodies), got %" PRId64 " x %" PRId64 " patches, %" PRId64 " bodies\n",
                  o.b.c_str(), o.a.c_str(), ca.patchesX, ca.patchesZ, ca.bodies, cb.patchesX, cb.patchesZ, cb.bodies);
     return kExitBadInput;
   }
@@ -209,34 +212,41 @@ int diff(const DiffOptions& o) {
     out["divergenceBy"] = by;
     summaryJson(summary, out);
     if (!o.heatmap.empty()) {
-      if (heatTaken) out["heatmap"] = {{"file", o.heatmap}, {"tick", a.heat.tick}};
-      else out["heatmapError"] = heatError;
+      if (heatTaken)
+        out["heatmap"] = {{"file", o.heatmap}, {"tick", a.heat.tick}};
+      else
+        out["heatmapError"] = heatError;
     }
     nlohmann::json s = nlohmann::json::array();
     for (const TickDivergence& d : series) s.push_back(tickJson(d));
     out["series"] = std::move(s);
     std::printf("%s\n", out.dump(2).c_str());
   } else {
-    std::printf("A           %s: %s, %s; %s\n", o.a.c_str(), a.run->player().scenario().name.c_str(), a.settings().c_str(),
-                a.verifiedText().c_str());
-    std::printf("B           %s: %s, %s; %s\n", o.b.c_str(), b.run->player().scenario().name.c_str(), b.settings().c_str(),
-                b.verifiedText().c_str());
+    std::printf("A           %s: %s, %s; %s\n", o.a.c_str(), a.run->player().scenario().name.c_str(),
+                a.settings().c_str(), a.verifiedText().c_str());
+    std::printf("B           %s: %s, %s; %s\n", o.b.c_str(), b.run->player().scenario().name.c_str(),
+                b.settings().c_str(), b.verifiedText().c_str());
     std::string timeBase;
     if (b.ticksPerStep > 1) timeBase = "; B takes " + std::to_string(b.ticksPerStep) + " ticks per tick of A";
     if (a.ticksPerStep > 1) timeBase = "; every " + std::to_string(a.ticksPerStep) + " ticks of A, one of B";
-    std::printf("ticks       0 to %" PRId64 " in A's ticks, %zu states compared%s\n", compared, series.size(), timeBase.c_str());
+    std::printf("ticks       0 to %" PRId64 " in A's ticks, %zu states compared%s\n", compared, series.size(),
+                timeBase.c_str());
     if (firstDivergent < 0)
-      std::printf("divergence  none: %s\n", comparable ? "every state hash is equal" : "tips, bodies and contacts agree at every tick");
+      std::printf("divergence  none: %s\n",
+                  comparable ? "every state hash is equal" : "tips, bodies and contacts agree at every tick");
     else
-      std::printf("divergence  from tick %" PRId64 " (%s)\n", firstDivergent,
-                  comparable ? "the first state hash that differs" : "the first tips, bodies or contacts that differ; the settings differ, so hashes do not compare");
+      std::printf(
+          "divergence  from tick %" PRId64 " (%s)\n", firstDivergent,
+          comparable ? "the first state hash that differs"
+                     : "the first tips, bodies or contacts that differ; the settings differ, so hashes do not compare");
     std::printf("tip error   max %s m (tick %" PRId64 "), rms %s m over all patches and ticks\n",
                 shortNumber(summary.tipMax).c_str(), summary.tipMaxTick, shortNumber(summary.tipRms()).c_str());
     std::printf("bodies      position max %s m, angle max %s rad, contacts max |A - B| %" PRId64 "\n",
-                shortNumber(summary.bodyPosMax).c_str(), shortNumber(summary.bodyAngleMax).c_str(), summary.contactDeltaMax);
+                shortNumber(summary.bodyPosMax).c_str(), shortNumber(summary.bodyAngleMax).c_str(),
+                summary.contactDeltaMax);
     if (!o.heatmap.empty())
-      std::printf("heat map    %s\n", heatTaken ? (o.heatmap + " (tick " + std::to_string(a.heat.tick) + ")").c_str()
-                                              : heatError.c_str());
+      std::printf("heat map    %s\n",
+                  heatTaken ? (o.heatmap + " (tick " + std::to_string(a.heat.tick) + ")").c_str() : heatError.c_str());
     if (!o.csv.empty()) std::printf("csv         %s (%zu rows)\n", o.csv.c_str(), series.size());
   }
   if (code == kExitOk && firstDivergent >= 0) code = kExitMismatch;
@@ -246,16 +256,20 @@ int diff(const DiffOptions& o) {
 
 void addDiffCommand(CLI::App& app, int* exitCode) {
   auto o = std::make_shared<DiffOptions>();
-  CLI::App* cmd = app.add_subcommand("diff", "Replay two recordings side by side: first divergent tick, tip, body and contact errors per tick");
+  CLI::App* cmd = app.add_subcommand(
+      "diff", "Replay two recordings side by side: first divergent tick, tip, body and contact errors per tick");
   cmd->add_option("a", o->a, "First recording (.sgr): the reference, whose ticks are reported")->required();
   cmd->add_option("b", o->b, "Second recording (.sgr) of a field the same size (other settings allowed)")->required();
   cmd->add_option("--csv", o->csv, "Write one row per compared tick to this CSV file");
   cmd->add_option("--heatmap", o->heatmap, "Write a PNG heat map of the tip distance over the meadow");
-  cmd->add_option("--heatmap-tick", o->heatmapTick, "Tick of the heat map: a tick, 'last' (default) or 'max' (largest tip error)");
-  cmd->add_option("--threads", o->threads, "Worker threads per replay (results are identical for any count)")->check(CLI::Range(1, 256));
+  cmd->add_option("--heatmap-tick", o->heatmapTick,
+                  "Tick of the heat map: a tick, 'last' (default) or 'max' (largest tip error)");
+  cmd->add_option("--threads", o->threads, "Worker threads per replay (results are identical for any count)")
+      ->check(CLI::Range(1, 256));
   cmd->add_flag("--json", o->json, "Machine-readable output, with the per-tick series");
-  cmd->footer("Exit codes (like diff(1)): 0 the runs agree at every tick, 1 they diverge (or a replay faulted or left "
-              "its recording), 2 bad input.");
+  cmd->footer(
+      "Exit codes (like diff(1)): 0 the runs agree at every tick, 1 they diverge (or a replay faulted or left "
+      "its recording), 2 bad input.");
   cmd->callback([o, exitCode] { *exitCode = diff(*o); });
 }
 }  // namespace sg

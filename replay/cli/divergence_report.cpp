@@ -1,7 +1,7 @@
 #include "replay/cli/divergence_report.h"
 
-#include <cinttypes>
 #include <unistd.h>
+#include <cinttypes>
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +18,8 @@ std::unique_ptr<sgr::Recording> loadRecordingFor(const char* command, const std:
     return nullptr;
   }
   if (rec->truncated)
-    std::fprintf(stderr, "simgrass %s: warning: %s: byte %" PRIu64 ": expected %s; using the %" PRId64 " ticks before it\n",
+    std::fprintf(stderr,
+                 "simgrass %s: warning: %s: byte %" PRIu64 ": expected %s; using the %" PRId64 " ticks before it\n",
                  command, path.c_str(), rec->truncatedAt, rec->truncatedExpected.c_str(), rec->lastTick());
   return rec;
 }
@@ -30,8 +31,7 @@ bool canWrite(const char* command, const std::string& path, const char* what) {
   const fs::path parent = fs::path(path).parent_path();
   const fs::path folder = parent.empty() ? fs::path(".") : parent;
   if (fs::is_directory(folder, ec) && ::access(folder.c_str(), W_OK) == 0 && !fs::is_directory(path, ec)) return true;
-  std::fprintf(stderr, "simgrass %s: %s: expected a %s in an existing, writable folder\n", command,
-               path.c_str(), what);
+  std::fprintf(stderr, "simgrass %s: %s: expected a %s in an existing, writable folder\n", command, path.c_str(), what);
   return false;
 }
 

@@ -113,16 +113,20 @@ int record(const RecordOptions& o) {
 
 void addRecordCommand(CLI::App& app, int* exitCode) {
   auto o = std::make_shared<RecordOptions>();
-  CLI::App* cmd = app.add_subcommand("record", "Run a scenario and stream a .sgr recording (inputs, hashes, snapshots)");
+  CLI::App* cmd =
+      app.add_subcommand("record", "Run a scenario and stream a .sgr recording (inputs, hashes, snapshots)");
   cmd->add_option("scenario", o->scenario, "Scenario JSON file (default: the built-in thesis meadow)");
   cmd->add_option("-o,--output", o->output, "Recording to write (.sgr)")->required();
   cmd->add_option("--ticks", o->ticks, "Ticks to record (default: the input track's 'ticks', else 600)")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
-  cmd->add_option("--input", o->inputTrack, "Input-track JSON (camera keys and body commands) instead of the scenario's script");
-  cmd->add_option("--variant", o->variants, "Settings over the scenario: scalar=fx16, interp=2, broadphase=brute, "
-                                            "body-broadphase=sap, dt=1/120 (repeatable)")
+  cmd->add_option("--input", o->inputTrack,
+                  "Input-track JSON (camera keys and body commands) instead of the scenario's script");
+  cmd->add_option("--variant", o->variants,
+                  "Settings over the scenario: scalar=fx16, interp=2, broadphase=brute, "
+                  "body-broadphase=sap, dt=1/120 (repeatable)")
       ->allow_extra_args(false);  // one value per --variant: a scenario path after it stays the scenario
-  cmd->add_option("--threads", o->threads, "Worker threads (the recording is identical for any count)")->check(CLI::Range(1, 256));
+  cmd->add_option("--threads", o->threads, "Worker threads (the recording is identical for any count)")
+      ->check(CLI::Range(1, 256));
   cmd->add_option("--check-every", o->checkEvery, "Ticks between state hashes (default: 1 up to ~130,000 patches)")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 30));
   cmd->add_option("--snapshot-every", o->snapshotEvery, "Ticks between zstd state snapshots (0: none)")

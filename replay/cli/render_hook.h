@@ -12,4 +12,4 @@
 namespace sg {
 /// Adds the `render` subcommand to `app`; its callback stores the command's exit code in *exitCode.
 void addRenderCommand(CLI::App& app, int* exitCode);
-}
+}  // namespace sg

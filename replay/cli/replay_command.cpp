@@ -1,7 +1,7 @@
 #include "replay/cli/replay_command.h"
 
-#include <filesystem>
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -9,8 +9,8 @@
 #include "replay/cli/cli_common.h"
 #include "replay/output_file.h"
 #include "replay/player.h"
-#include "replay/state_export.h"
 #include "replay/progress.h"
+#include "replay/state_export.h"
 
 namespace sg {
 namespace {
@@ -55,8 +55,9 @@ int replay(const ReplayOptions& o) {
     return kExitBadInput;
   }
   if (rec->truncated)
-    std::fprintf(stderr, "simgrass replay: warning: %s: byte %" PRIu64 ": expected %s; replaying the %" PRId64
-                         " ticks before it\n",
+    std::fprintf(stderr,
+                 "simgrass replay: warning: %s: byte %" PRIu64 ": expected %s; replaying the %" PRId64
+                 " ticks before it\n",
                  o.file.c_str(), rec->truncatedAt, rec->truncatedExpected.c_str(), rec->lastTick());
   nlohmann::json out = headerJson(*rec);
   if (o.info) {
@@ -82,7 +83,9 @@ int replay(const ReplayOptions& o) {
   }
   const int64_t last = rec->lastTick();
   if (o.to > last) {
-    std::fprintf(stderr, "simgrass replay: --to: expected a tick from %" PRId64 " to %" PRId64 " (the recording's last), got %" PRId64 "\n",
+    std::fprintf(stderr,
+                 "simgrass replay: --to: expected a tick from %" PRId64 " to %" PRId64
+                 " (the recording's last), got %" PRId64 "\n",
                  rec->header.startTick, last, o.to);
     return kExitBadInput;
   }
@@ -176,13 +179,18 @@ void addReplayCommand(CLI::App& app, int* exitCode) {
   CLI::App* cmd = app.add_subcommand("replay", "Play a .sgr recording back: verify its hashes, seek, export a state");
   cmd->add_option("recording", o->file, "Recording (.sgr)")->required();
   cmd->add_flag("--verify", o->verify, "Recompute every recorded hash; report the first tick that differs (exit 1)");
-  cmd->add_option("--to", o->to, "Seek to this tick through the nearest snapshot")->check(CLI::Range(int64_t(0), int64_t(1) << 40));
-  cmd->add_option("--export-state", o->exportState, "Write the state reached to this file: NAME.json the documented JSON form, any other name the binary state (docs/state-format.md)");
-  cmd->add_option("--threads", o->threads, "Worker threads (the result is identical for any count)")->check(CLI::Range(1, 256));
+  cmd->add_option("--to", o->to, "Seek to this tick through the nearest snapshot")
+      ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
+  cmd->add_option("--export-state", o->exportState,
+                  "Write the state reached to this file: NAME.json the documented JSON form, any other name the binary "
+                  "state (docs/state-format.md)");
+  cmd->add_option("--threads", o->threads, "Worker threads (the result is identical for any count)")
+      ->check(CLI::Range(1, 256));
   cmd->add_flag("--info", o->info, "Print what the recording holds without simulating");
   cmd->add_flag("--json", o->json, "Machine-readable output");
-  cmd->footer("Exit codes: 0 ok, 1 hash mismatch or simulation fault, 2 bad input, 3 recording cut off before END "
-              "(everything up to the cut checked out).");
+  cmd->footer(
+      "Exit codes: 0 ok, 1 hash mismatch or simulation fault, 2 bad input, 3 recording cut off before END "
+      "(everything up to the cut checked out).");
   cmd->callback([o, exitCode] { *exitCode = replay(*o); });
 }
 }  // namespace sg

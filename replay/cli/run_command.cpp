@@ -42,9 +42,11 @@ int runScenario(const RunOptions& o) {
     if (!o.scalar.empty()) scenario.scalar = *parseScalarKind(o.scalar);
     if (o.interp > 0) scenario.particles.interpolation = o.interp;
     if (!o.broadphase.empty())
-      scenario.bodies.particleBroadphase = o.broadphase == "brute" ? ParticleBroadphase::Brute : ParticleBroadphase::Grid;
+      scenario.bodies.particleBroadphase =
+          o.broadphase == "brute" ? ParticleBroadphase::Brute : ParticleBroadphase::Grid;
     if (!o.bodyBroadphase.empty())
-      scenario.bodies.bodyBroadphase = o.bodyBroadphase == "sap" ? BodyBroadphase::SweepAndPrune : BodyBroadphase::Brute;
+      scenario.bodies.bodyBroadphase =
+          o.bodyBroadphase == "sap" ? BodyBroadphase::SweepAndPrune : BodyBroadphase::Brute;
     if (!o.lod.empty()) scenario.lod.mode = o.lod == "window" ? LodMode::Window : LodMode::Off;
     world = makeWorld(scenario, o.threads, physicalMemoryBytes());
     if (o.kernel == "scalar" || o.kernel == "avx2")
@@ -95,19 +97,24 @@ int runScenario(const RunOptions& o) {
     j["interpolation"] = counts.interpolation;
     j["threads"] = counts.threads;
     j["kernel"] = particleKernelName(world->particleKernel());
-    j["counts"] = {{"patchesX", counts.patchesX}, {"patchesZ", counts.patchesZ}, {"patches", counts.patches()},
-                   {"particlesX", counts.particlesX}, {"particlesZ", counts.particlesZ},
-                   {"particles", counts.particles()}, {"bodies", counts.bodies}, {"contacts", counts.contacts}};
+    j["counts"] = {{"patchesX", counts.patchesX},     {"patchesZ", counts.patchesZ},
+                   {"patches", counts.patches()},     {"particlesX", counts.particlesX},
+                   {"particlesZ", counts.particlesZ}, {"particles", counts.particles()},
+                   {"bodies", counts.bodies},         {"contacts", counts.contacts}};
     if (counts.lodWindow)
-      j["lod"] = {{"windowPatchesX", counts.windowPatchesX}, {"windowPatchesZ", counts.windowPatchesZ},
-                  {"originI", counts.windowOriginI}, {"originJ", counts.windowOriginJ}};
+      j["lod"] = {{"windowPatchesX", counts.windowPatchesX},
+                  {"windowPatchesZ", counts.windowPatchesZ},
+                  {"originI", counts.windowOriginI},
+                  {"originJ", counts.windowOriginJ}};
     j["ticks"] = ran;
     j["finalHash"] = hex(finalHash);
     if (o.hashEvery > 0) j["hashes"] = hashes;
     nlohmann::json stages = nlohmann::json::object();
     for (size_t s = 0; s < size_t(Stage::Count); ++s)
       stages[stageName(Stage(s))] = ran > 0 ? double(clock.nanos[s]) / 1e6 / double(ran) : 0.0;
-    j["timing"] = {{"seconds", seconds}, {"msPerTick", msPerTick}, {"patchStepsPerSecond", patchSteps},
+    j["timing"] = {{"seconds", seconds},
+                   {"msPerTick", msPerTick},
+                   {"patchStepsPerSecond", patchSteps},
                    {"stageMsPerTick", stages}};
     if (!failure.ok) j["error"] = failure.error.message();
     std::printf("%s\n", j.dump(2).c_str());
@@ -116,12 +123,13 @@ int runScenario(const RunOptions& o) {
     std::printf("scalar     %s, interpolation k=%d, %d thread%s, %s particle kernel\n", scalarName(scenario.scalar),
                 counts.interpolation, counts.threads, counts.threads == 1 ? "" : "s",
                 particleKernelName(world->particleKernel()));
-    std::printf("patches    %" PRId64 " (%" PRId64 " x %" PRId64 "), particles %" PRId64 " (%" PRId64 " x %" PRId64 ")\n",
-                counts.patches(), counts.patchesX, counts.patchesZ, counts.particles(), counts.particlesX,
-                counts.particlesZ);
+    std::printf(
+        "patches    %" PRId64 " (%" PRId64 " x %" PRId64 "), particles %" PRId64 " (%" PRId64 " x %" PRId64 ")\n",
+        counts.patches(), counts.patchesX, counts.patchesZ, counts.particles(), counts.particlesX, counts.particlesZ);
     if (counts.lodWindow) {
       const WorldCounts now = world->counts();
-      std::printf("lod        window of %" PRId64 " x %" PRId64 " patches, at patch (%" PRId64 ", %" PRId64 ") after the last tick\n",
+      std::printf("lod        window of %" PRId64 " x %" PRId64 " patches, at patch (%" PRId64 ", %" PRId64
+                  ") after the last tick\n",
                   now.windowPatchesX, now.windowPatchesZ, now.windowOriginI, now.windowOriginJ);
     }
     if (counts.bodies > 0)
@@ -146,9 +154,11 @@ int runScenario(const RunOptions& o) {
 
 void addRunCommand(CLI::App& app, int* exitCode) {
   auto opts = std::make_shared<RunOptions>();
-  CLI::App* run = app.add_subcommand("run", "Run a scenario headless and print the final state hash, timings and counts");
+  CLI::App* run =
+      app.add_subcommand("run", "Run a scenario headless and print the final state hash, timings and counts");
   run->add_option("scenario", opts->scenario, "Scenario JSON file (default: the built-in thesis meadow)");
-  run->add_option("--ticks", opts->ticks, "Number of fixed ticks to run")->check(CLI::Range(int64_t(0), int64_t(1) << 40));
+  run->add_option("--ticks", opts->ticks, "Number of fixed ticks to run")
+      ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
   run->add_option("--scalar", opts->scalar, "Scalar type, overriding the scenario")
       ->check(CLI::IsMember({"fx32", "fx16", "float", "double"}));
   run->add_option("--interp", opts->interp, "Interpolation k (1 = one particle per patch, 2 = per 2x2, ...)")

@@ -117,21 +117,21 @@ VariantSettings referenceSettings() {
 /// One scenario of the sweep, with its reference run recorded and observed at the common times.
 struct SweepScenario {
   std::string file, name;
-  Scenario reference;                 ///< the scenario under the reference settings, script in reference ticks
+  Scenario reference;  ///< the scenario under the reference settings, script in reference ticks
   std::vector<sgr::EmbeddedFile> files;
   int64_t patches = 0, bodies = 0;
   std::unique_ptr<sgr::Recording> recording;  ///< the reference's inputs
-  std::vector<Observation> observed;  ///< the reference at ticks 0, M, 2M, ... (M: the common interval)
+  std::vector<Observation> observed;          ///< the reference at ticks 0, M, 2M, ... (M: the common interval)
 };
 
 /// One row: a variant of one scenario and what it measured.
 struct SweepRow {
   size_t scenario = 0;
   VariantSettings settings;
-  int64_t steps = 0;                 ///< own ticks per run
-  std::vector<double> runMs;         ///< stepping time of each repeat, ms
+  int64_t steps = 0;          ///< own ticks per run
+  std::vector<double> runMs;  ///< stepping time of each repeat, ms
   DivergenceSummary summary;
-  std::string fault;                 ///< empty: ran to the end
+  std::string fault;  ///< empty: ran to the end
   double msPerTick = 0, msPerSimSecond = 0;
   bool pareto = false, paretoTipMax = false, paretoBody = false;
 
@@ -270,10 +270,14 @@ double zeroFloor(const std::vector<double>& errors) {
 
 plot::Rgb scalarColour(ScalarKind s) {
   switch (s) {
-    case ScalarKind::Fx16: return {214, 39, 40};
-    case ScalarKind::Fx32: return {31, 119, 180};
-    case ScalarKind::Float: return {44, 160, 44};
-    case ScalarKind::Double: return {148, 103, 189};
+    case ScalarKind::Fx16:
+      return {214, 39, 40};
+    case ScalarKind::Fx32:
+      return {31, 119, 180};
+    case ScalarKind::Float:
+      return {44, 160, 44};
+    case ScalarKind::Double:
+      return {148, 103, 189};
   }
   return {0, 0, 0};
 }
@@ -304,8 +308,13 @@ plot::ScatterPlot errorPlot(const SweepScenario& sc, const std::vector<const Swe
       continue;
     }
     const double e = error(*r) > 0 ? error(*r) : floor;
-    plot::Point pt{r->msPerSimSecond, e, scalarColour(*r->settings.scalar), kMarker(*r->settings.interpolation),
-                   *r->settings.lod == LodMode::Window, r->*onFront, ""};
+    plot::Point pt{r->msPerSimSecond,
+                   e,
+                   scalarColour(*r->settings.scalar),
+                   kMarker(*r->settings.interpolation),
+                   *r->settings.lod == LodMode::Window,
+                   r->*onFront,
+                   ""};
     if (r->*onFront) {
       pt.label = r->label();
       front.push_back({r->msPerSimSecond, r});
@@ -326,7 +335,9 @@ plot::ScatterPlot errorPlot(const SweepScenario& sc, const std::vector<const Swe
   std::snprintf(buf, sizeof buf, "An error of 0 (identical to the reference) is plotted at %s %s.",
                 plot::tickLabel(floor).c_str(), unit.c_str());
   p.notes.push_back(buf);
-  p.notes.push_back("Reference: double, k = 1, dt = 1/240, LOD off. Pareto points are ringed and labelled: scalar, k, dt, win = LOD window.");
+  p.notes.push_back(
+      "Reference: double, k = 1, dt = 1/240, LOD off. Pareto points are ringed and labelled: scalar, k, dt, win = LOD "
+      "window.");
   std::snprintf(buf, sizeof buf, "Cost: median of %d run%s, %d thread%s; errors over %zu common times.", repeats,
                 repeats == 1 ? "" : "s", threads, threads == 1 ? "" : "s", sc.observed.size());
   p.notes.push_back(buf);
@@ -402,8 +413,10 @@ int sweep(const SweepOptions& o) {
     try {
       if (file.empty()) throw ScenarioError("--scenarios", "$", "a comma-separated list of scenario files");
       if (!fs::is_regular_file(file))
-        throw ScenarioError(file, "$", std::string("a scenario file") +
-                                           (o.scenarios == kDefaultScenarios ? " (run from the repository root or pass --scenarios)" : ""));
+        throw ScenarioError(
+            file, "$",
+            std::string("a scenario file") +
+                (o.scenarios == kDefaultScenarios ? " (run from the repository root or pass --scenarios)" : ""));
       Scenario s = loadScenarioFile(file, &sc.files);
       sc.name = s.name;
       const Rational ownDt = s.timeStep;
@@ -453,8 +466,7 @@ int sweep(const SweepOptions& o) {
     for (SweepRow& r : rows) {
       if (!r.fault.empty()) continue;
       const int64_t base = done;
-      runVariant(scenarios[r.scenario], r, interval, o.threads, rep == 0,
-                 [&](int64_t t) { bar.update(base + t); });
+      runVariant(scenarios[r.scenario], r, interval, o.threads, rep == 0, [&](int64_t t) { bar.update(base + t); });
       done = base + rowTicks;
       bar.update(done);
     }
@@ -551,9 +563,10 @@ int sweep(const SweepOptions& o) {
     for (const Kind& k : kinds) {
       const std::string path = (fs::path(o.out) / (base + "-" + k.suffix + ".png")).string();
       std::string error;
-      if (!plot::writePng(path, plot::render(errorPlot(scenarios[s], mine, axes, k.what, k.unit, k.error, k.front,
-                                                        o.repeats, o.threads)),
-                          &error)) {
+      if (!plot::writePng(
+              path,
+              plot::render(errorPlot(scenarios[s], mine, axes, k.what, k.unit, k.error, k.front, o.repeats, o.threads)),
+              &error)) {
         std::fprintf(stderr, "simgrass sweep: %s\n", error.c_str());
         return kExitBadInput;
       }
@@ -576,10 +589,11 @@ int sweep(const SweepOptions& o) {
   if (o.json) {
     std::printf("%s\n", doc.dump(2).c_str());
   } else {
-    std::printf("reference  scalar=double interp=1 dt=%s lod=off; %g simulated s, compared every %g s; cost: median "
-                "of %d run%s, %d thread%s\n",
-                refDt.toString().c_str(), double(ticks) * refDtS, double(interval) * refDtS, o.repeats,
-                o.repeats == 1 ? "" : "s", o.threads, o.threads == 1 ? "" : "s");
+    std::printf(
+        "reference  scalar=double interp=1 dt=%s lod=off; %g simulated s, compared every %g s; cost: median "
+        "of %d run%s, %d thread%s\n",
+        refDt.toString().c_str(), double(ticks) * refDtS, double(interval) * refDtS, o.repeats,
+        o.repeats == 1 ? "" : "s", o.threads, o.threads == 1 ? "" : "s");
     for (size_t s = 0; s < scenarios.size(); ++s) {
       const SweepScenario& sc = scenarios[s];
       std::printf("\n%s (%s): %" PRId64 " patches, %" PRId64 " bodies\n", sc.name.c_str(), sc.file.c_str(), sc.patches,
@@ -590,8 +604,10 @@ int sweep(const SweepOptions& o) {
         if (r.scenario != s) continue;
         const int64_t first = r.summary.firstObservedTick;
         char diverges[32];
-        if (first < 0) std::snprintf(diverges, sizeof diverges, "never");
-        else std::snprintf(diverges, sizeof diverges, "%.3g s", double(first) * refDtS);
+        if (first < 0)
+          std::snprintf(diverges, sizeof diverges, "never");
+        else
+          std::snprintf(diverges, sizeof diverges, "%.3g s", double(first) * refDtS);
         std::printf("%-28s %10.3f %12.1f %11s %11s %11s %9s  %s%s\n", r.label().c_str(), r.msPerTick, r.msPerSimSecond,
                     shortNumber(r.summary.tipRms()).c_str(), shortNumber(r.summary.tipMax).c_str(),
                     shortNumber(r.summary.bodyPosMax).c_str(), diverges, r.status().c_str(),
@@ -600,12 +616,13 @@ int sweep(const SweepOptions& o) {
     }
     std::printf("\nwrote      %s, %s and %zu plots in %s\n", csvPath.c_str(), jsonPath.c_str(), pngs.size(),
                 o.out.c_str());
-    std::printf("* pareto: no other variant of the scenario is both cheaper (ms per simulated second) and more "
-                "accurate (tip RMS error).\n");
+    std::printf(
+        "* pareto: no other variant of the scenario is both cheaper (ms per simulated second) and more "
+        "accurate (tip RMS error).\n");
   }
   if (faults > 0) {
-    std::fprintf(stderr, "simgrass sweep: %d variant%s faulted (status column in %s)\n", faults,
-                 faults == 1 ? "" : "s", csvPath.c_str());
+    std::fprintf(stderr, "simgrass sweep: %d variant%s faulted (status column in %s)\n", faults, faults == 1 ? "" : "s",
+                 csvPath.c_str());
     return kExitMismatch;
   }
   return kExitOk;
@@ -615,8 +632,9 @@ int sweep(const SweepOptions& o) {
 void addSweepCommand(CLI::App& app, int* exitCode) {
   auto o = std::make_shared<SweepOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "sweep", "Every variant (scalar x k x dt x LOD) against a double, k=1, dt=1/240 reference: cost per simulated "
-               "second against tip and body error; CSV, JSON and PNG plots with the Pareto front");
+      "sweep",
+      "Every variant (scalar x k x dt x LOD) against a double, k=1, dt=1/240 reference: cost per simulated "
+      "second against tip and body error; CSV, JSON and PNG plots with the Pareto front");
   cmd->add_option("--scenarios", o->scenarios, "Comma-separated scenario files")->capture_default_str();
   cmd->add_option("--seconds", o->seconds, "Simulated seconds per run")
       ->check(CLI::Range(1e-3, 3600.0))

@@ -52,36 +52,36 @@ struct EmbeddedFile {
 
 struct Header {
   ScalarKind scalar = ScalarKind::Fx32;
-  uint32_t checkEvery = 1;       ///< ticks between CHCK chunks (0: none)
-  uint32_t snapshotEvery = 300;  ///< ticks between SNAP chunks (0: none)
-  uint64_t scenarioHash = 0;     ///< XXH3-64 of scenarioText
-  uint64_t initialStateHash = 0; ///< state hash at startTick, before any input
+  uint32_t checkEvery = 1;        ///< ticks between CHCK chunks (0: none)
+  uint32_t snapshotEvery = 300;   ///< ticks between SNAP chunks (0: none)
+  uint64_t scenarioHash = 0;      ///< XXH3-64 of scenarioText
+  uint64_t initialStateHash = 0;  ///< state hash at startTick, before any input
   int64_t startTick = 0;
-  std::string variant;           ///< resolved settings, "scalar=fx32 interp=1 ..." (replay/variant.h)
-  std::string scenarioSource;    ///< the scenario file name when it was recorded
-  std::string scenarioText;      ///< the scenario JSON, verbatim
+  std::string variant;         ///< resolved settings, "scalar=fx32 interp=1 ..." (replay/variant.h)
+  std::string scenarioSource;  ///< the scenario file name when it was recorded
+  std::string scenarioText;    ///< the scenario JSON, verbatim
   std::vector<EmbeddedFile> files;
-  std::string buildId;           ///< "simgrass 0.4.0 gcc 12.2 Release" (informational)
+  std::string buildId;  ///< "simgrass 0.4.0 gcc 12.2 Release" (informational)
 };
 
 struct Check {
-  int64_t tick = 0;   ///< state after this many ticks
+  int64_t tick = 0;  ///< state after this many ticks
   uint64_t hash = 0;
 };
 
 struct SnapshotInfo {
   int64_t tick = 0;
-  uint64_t hash = 0;          ///< stateHash() of the state it holds
-  uint64_t rawBytes = 0;      ///< size of the state once decompressed
-  uint64_t offset = 0;        ///< file offset of the zstd frame
+  uint64_t hash = 0;      ///< stateHash() of the state it holds
+  uint64_t rawBytes = 0;  ///< size of the state once decompressed
+  uint64_t offset = 0;    ///< file offset of the zstd frame
   uint64_t compressedBytes = 0;
 };
 
 struct EndInfo {
   int64_t tick = 0;
   uint64_t hash = 0;
-  bool faulted = false;       ///< the simulation stopped with an error at `tick`
-  std::string message;        ///< the error, when faulted
+  bool faulted = false;  ///< the simulation stopped with an error at `tick`
+  std::string message;   ///< the error, when faulted
 };
 
 /// One tick's recorded input (the camera is carried forward from earlier ticks).
@@ -98,6 +98,7 @@ class RecordingError : public std::runtime_error {
   const std::string& file() const { return file_; }
   uint64_t offset() const { return offset_; }
   const std::string& expected() const { return expected_; }
+
  private:
   std::string file_;
   uint64_t offset_;

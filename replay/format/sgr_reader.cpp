@@ -1,27 +1,34 @@
 #include "replay/format/sgr_reader.h"
 #include "sim/state/byte_order.h"
 
+#include <xxhash.h>
+#include <zstd.h>
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <xxhash.h>
-#include <zstd.h>
 
 namespace sg::sgr {
 
 RecordingError::RecordingError(const std::string& file, uint64_t offset, const std::string& expected)
     : std::runtime_error(file + ": byte " + std::to_string(offset) + ": expected " + expected),
-      file_(file), offset_(offset), expected_(expected) {}
+      file_(file),
+      offset_(offset),
+      expected_(expected) {}
 
 const char* chunkTypeName(ChunkType type) {
   switch (type) {
-    case ChunkType::Head: return "HEAD";
-    case ChunkType::Input: return "INPT";
-    case ChunkType::Check: return "CHCK";
-    case ChunkType::Snapshot: return "SNAP";
-    case ChunkType::End: return "END";
+    case ChunkType::Head:
+      return "HEAD";
+    case ChunkType::Input:
+      return "INPT";
+    case ChunkType::Check:
+      return "CHCK";
+    case ChunkType::Snapshot:
+      return "SNAP";
+    case ChunkType::End:
+      return "END";
   }
   return "unknown";
 }
@@ -54,7 +61,8 @@ class Cursor {
   std::vector<uint8_t> bytes(const char* what) {
     const uint64_t at = offset();
     const uint32_t n = get<uint32_t>(what);
-    if (n > remaining()) fail(at, std::string(what) + " length that fits the " + chunk_ + " chunk, got " + std::to_string(n));
+    if (n > remaining())
+      fail(at, std::string(what) + " length that fits the " + chunk_ + " chunk, got " + std::to_string(n));
     std::vector<uint8_t> b(p_.begin() + ptrdiff_t(at_), p_.begin() + ptrdiff_t(at_ + n));
     at_ += n;
     return b;
@@ -68,9 +76,12 @@ class Cursor {
   }
   void finished() {
     if (remaining() != 0)
-      fail(offset(), std::string("the end of the ") + chunk_ + " chunk, got " + std::to_string(remaining()) + " extra bytes");
+      fail(offset(),
+           std::string("the end of the ") + chunk_ + " chunk, got " + std::to_string(remaining()) + " extra bytes");
   }
-  [[noreturn]] void fail(uint64_t at, const std::string& expected) const { throw RecordingError(r_.file, at, expected); }
+  [[noreturn]] void fail(uint64_t at, const std::string& expected) const {
+    throw RecordingError(r_.file, at, expected);
+  }
 
  private:
   void need(size_t n, const char* what) const {
@@ -88,7 +99,7 @@ class Cursor {
 int64_t nextOnGrid(int64_t last, int64_t startTick, uint32_t every) {
   const int64_t from = last < 0 ? startTick : last;
   return every == 0 || from > std::numeric_limits<int64_t>::max() - int64_t(every) ? std::numeric_limits<int64_t>::max()
-                                                                                     : from + int64_t(every);
+                                                                                   : from + int64_t(every);
 }
 
 /// CHCK and SNAP chunks sit exactly every `every` ticks from the start: a missing or stray one is
@@ -103,11 +114,16 @@ void expectOnGrid(const Cursor& c, uint64_t at, int64_t tick, int64_t last, int6
 
 uint64_t maxPayload(ChunkType t) {
   switch (t) {
-    case ChunkType::Head: return kMaxHeadPayload;
-    case ChunkType::Input: return kMaxInputPayload;
-    case ChunkType::Check: return 16;
-    case ChunkType::Snapshot: return kMaxSnapshotPayload;
-    case ChunkType::End: return 8 + 8 + 1 + 4 + 4096;
+    case ChunkType::Head:
+      return kMaxHeadPayload;
+    case ChunkType::Input:
+      return kMaxInputPayload;
+    case ChunkType::Check:
+      return 16;
+    case ChunkType::Snapshot:
+      return kMaxSnapshotPayload;
+    case ChunkType::End:
+      return 8 + 8 + 1 + 4 + 4096;
   }
   return 0;
 }
@@ -167,7 +183,8 @@ void parseInput(Recording& r, Cursor& c, TickInput& camera) {
   rec.offset = tickAt;
   rec.tick = c.get<int64_t>("the input tick");
   const int64_t after = r.inputs.empty() ? r.header.startTick - 1 : r.inputs.back().tick;
-  if (rec.tick <= after) c.fail(tickAt, "an input tick after " + std::to_string(after) + ", got " + std::to_string(rec.tick));
+  if (rec.tick <= after)
+    c.fail(tickAt, "an input tick after " + std::to_string(after) + ", got " + std::to_string(rec.tick));
   const uint64_t flagsAt = c.offset();
   const uint8_t flags = c.get<uint8_t>("the input flags");
   if (flags > 1) c.fail(flagsAt, "input flags 0 or 1, got " + std::to_string(flags));
@@ -193,7 +210,8 @@ void parseInput(Recording& r, Cursor& c, TickInput& camera) {
     const uint64_t kindAt = c.offset();
     const uint8_t kind = c.get<uint8_t>("a command kind");
     if (kind > uint8_t(BodyCommandKind::MowerOff))
-      c.fail(kindAt, "a command kind 0.." + std::to_string(int(BodyCommandKind::MowerOff)) + ", got " + std::to_string(kind));
+      c.fail(kindAt,
+             "a command kind 0.." + std::to_string(int(BodyCommandKind::MowerOff)) + ", got " + std::to_string(kind));
     cmd.kind = BodyCommandKind(kind);
     cmd.value = c.vec3("a command value");
     rec.input.bodies.push_back(cmd);
@@ -215,7 +233,8 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
   }
   const uint32_t version = loadLE<uint32_t>(all.data() + 8);
   if (version != kFormatVersion)
-    throw RecordingError(file, 8, "format version " + std::to_string(kFormatVersion) + ", got " + std::to_string(version));
+    throw RecordingError(file, 8,
+                         "format version " + std::to_string(kFormatVersion) + ", got " + std::to_string(version));
 
   uint64_t at = kPreambleBytes;
   bool haveHead = false;
@@ -234,11 +253,13 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
     }
     const uint32_t type = loadLE<uint32_t>(all.data() + at);
     const uint32_t length = loadLE<uint32_t>(all.data() + at + 4);
-    if (!knownType(type)) throw RecordingError(file, at, "a chunk type HEAD, INPT, CHCK, SNAP or END, got " + typeText(type));
+    if (!knownType(type))
+      throw RecordingError(file, at, "a chunk type HEAD, INPT, CHCK, SNAP or END, got " + typeText(type));
     const ChunkType t = ChunkType(type);
     if (length > maxPayload(t))
-      throw RecordingError(file, at + 4, std::string("a ") + chunkTypeName(t) + " payload of at most " +
-                                             std::to_string(maxPayload(t)) + " bytes, got " + std::to_string(length));
+      throw RecordingError(file, at + 4,
+                           std::string("a ") + chunkTypeName(t) + " payload of at most " +
+                               std::to_string(maxPayload(t)) + " bytes, got " + std::to_string(length));
     const uint64_t total = kChunkHeaderBytes + uint64_t(length) + kChunkTrailerBytes;
     if (all.size() - at < total) {
       truncate(at, std::string("a ") + chunkTypeName(t) + " chunk of " + std::to_string(total) + " bytes, " +
@@ -318,8 +339,9 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
         // (A faulted END is replayed one step further: its tick must leave room for that step.)
         const int64_t lastAllowed = std::min(e.faulted ? nextCheck : nextCheck - 1, kMaxTick - 1);
         if (e.tick < covered || e.tick > lastAllowed)
-          c.fail(at + kChunkHeaderBytes, "a final tick from " + std::to_string(covered) + " to before the next check at " +
-                                             std::to_string(nextCheck) + ", got " + std::to_string(e.tick));
+          c.fail(at + kChunkHeaderBytes, "a final tick from " + std::to_string(covered) +
+                                             " to before the next check at " + std::to_string(nextCheck) + ", got " +
+                                             std::to_string(e.tick));
         r.end = e;
         break;
       }
@@ -343,7 +365,8 @@ Recording readRecording(const std::string& path, uint64_t maxBytes) {
   if (!in) throw RecordingError(path, 0, "a readable file");
   std::vector<uint8_t> bytes(size);
   in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size));
-  if (uint64_t(in.gcount()) != size) throw RecordingError(path, uint64_t(in.gcount()), "the rest of the file (read failed)");
+  if (uint64_t(in.gcount()) != size)
+    throw RecordingError(path, uint64_t(in.gcount()), "the rest of the file (read failed)");
   return parseRecording(std::move(bytes), path);
 }
 
@@ -356,8 +379,8 @@ int64_t Recording::lastTick() const {
 }
 
 TickInput Recording::inputAt(int64_t tick) const {
-  auto it = std::upper_bound(inputs.begin(), inputs.end(), tick,
-                             [](int64_t t, const InputRecord& r) { return t < r.tick; });
+  auto it =
+      std::upper_bound(inputs.begin(), inputs.end(), tick, [](int64_t t, const InputRecord& r) { return t < r.tick; });
   if (it == inputs.begin()) return {};
   --it;
   if (it->tick == tick) return it->input;
@@ -381,7 +404,8 @@ std::vector<uint8_t> Recording::snapshotState(const SnapshotInfo& s) const {
   std::vector<uint8_t> state(size_t(s.rawBytes));
   const size_t n = ZSTD_decompress(state.data(), state.size(), frame, size_t(s.compressedBytes));
   if (ZSTD_isError(n) || n != state.size())
-    throw RecordingError(file, s.offset, std::string("a valid zstd frame (") + (ZSTD_isError(n) ? ZSTD_getErrorName(n) : "short") + ")");
+    throw RecordingError(
+        file, s.offset, std::string("a valid zstd frame (") + (ZSTD_isError(n) ? ZSTD_getErrorName(n) : "short") + ")");
   return state;
 }
 

@@ -18,8 +18,8 @@ struct Recording {
   std::string file;            ///< for messages
   std::vector<uint8_t> bytes;  ///< the whole file (snapshots decompress from here)
   Header header;
-  std::vector<InputRecord> inputs;  ///< sorted by tick; camera already carried forward
-  std::vector<Check> checks;        ///< sorted by tick
+  std::vector<InputRecord> inputs;      ///< sorted by tick; camera already carried forward
+  std::vector<Check> checks;            ///< sorted by tick
   std::vector<SnapshotInfo> snapshots;  ///< sorted by tick
   std::optional<EndInfo> end;
   /// The file ended inside a chunk (or before END): what was there and where it stopped.

@@ -4,12 +4,12 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <xxhash.h>
+#include <zstd.h>
 #include <bit>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
-#include <xxhash.h>
-#include <zstd.h>
 
 namespace sg::sgr {
 namespace {

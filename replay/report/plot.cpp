@@ -18,7 +18,7 @@ namespace sg::plot {
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr Rgb kWhite{255, 255, 255}, kBlack{0, 0, 0}, kGrid{228, 228, 228}, kAxis{60, 60, 60};
-constexpr int kMarkerRadius = 5;  ///< px: markers are 11 px across
+constexpr int kMarkerRadius = 5;   ///< px: markers are 11 px across
 constexpr int kLegendWidth = 250;  ///< px: the panel right of the plot area
 
 /// The value as the axis sees it: log10 on a log axis (NaN for values <= 0 or not finite).
@@ -67,10 +67,14 @@ std::vector<double> majorTicks(double lo, double hi, bool log) {
 /// True when offset (dx, dy) from a marker's centre lies inside the marker of radius r.
 bool insideMarker(Marker m, int dx, int dy, int r) {
   switch (m) {
-    case Marker::Circle: return dx * dx + dy * dy <= r * r;
-    case Marker::Square: return std::abs(dx) <= r - 1 && std::abs(dy) <= r - 1;
-    case Marker::Diamond: return std::abs(dx) + std::abs(dy) <= r;
-    case Marker::Triangle: return dy >= -r && dy <= r - 1 && 2 * std::abs(dx) <= dy + r;  // apex up
+    case Marker::Circle:
+      return dx * dx + dy * dy <= r * r;
+    case Marker::Square:
+      return std::abs(dx) <= r - 1 && std::abs(dy) <= r - 1;
+    case Marker::Diamond:
+      return std::abs(dx) + std::abs(dy) <= r;
+    case Marker::Triangle:
+      return dy >= -r && dy <= r - 1 && 2 * std::abs(dx) <= dy + r;  // apex up
   }
   return false;
 }
@@ -83,8 +87,10 @@ void drawMarker(Canvas& c, int cx, int cy, Marker m, Rgb colour, bool hollow, bo
       if (ringed && d2 <= ringOuter * ringOuter && d2 > ringInner * ringInner) c.set(cx + dx, cy + dy, kBlack);
       if (!insideMarker(m, dx, dy, r)) continue;
       const bool edge = !insideMarker(m, dx, dy, r - 2);
-      if (!hollow || edge) c.set(cx + dx, cy + dy, colour);
-      else c.set(cx + dx, cy + dy, kWhite);
+      if (!hollow || edge)
+        c.set(cx + dx, cy + dy, colour);
+      else
+        c.set(cx + dx, cy + dy, kWhite);
     }
 }
 
@@ -95,13 +101,17 @@ std::vector<std::string> wrap(const std::string& s, int width, int scale) {
   auto flushWord = [&] {
     if (word.empty()) return;
     const std::string joined = line.empty() ? word : line + " " + word;
-    if (!line.empty() && Canvas::textWidth(joined, scale) > width) lines.push_back(line), line = word;
-    else line = joined;
+    if (!line.empty() && Canvas::textWidth(joined, scale) > width)
+      lines.push_back(line), line = word;
+    else
+      line = joined;
     word.clear();
   };
   for (char ch : s) {
-    if (ch == ' ') flushWord();
-    else word += ch;
+    if (ch == ' ')
+      flushWord();
+    else
+      word += ch;
   }
   flushWord();
   if (!line.empty()) lines.push_back(line);
@@ -235,8 +245,10 @@ Image render(const ScatterPlot& plot) {
   const int lx = a.right + 16, legendTextW = plot.width - lx - 8;
   int ly = a.top;
   for (const LegendEntry& e : plot.legend) {
-    if (e.isLine) c.line(lx, ly + 6, lx + 16, ly + 6, 2, e.colour, 0, 0, plot.width, plot.height);
-    else drawMarker(c, lx + 8, ly + 6, e.marker, e.colour, e.hollow, false);
+    if (e.isLine)
+      c.line(lx, ly + 6, lx + 16, ly + 6, 2, e.colour, 0, 0, plot.width, plot.height);
+    else
+      drawMarker(c, lx + 8, ly + 6, e.marker, e.colour, e.hollow, false);
     c.text(lx + 24, ly, e.text, 2, kBlack);
     ly += 20;
   }
@@ -260,11 +272,11 @@ bool writePng(const std::string& path, const Image& image, std::string* error) {
   return true;
 }
 
-
 Canvas::Canvas(int w, int h, Rgb background) {
   img.width = w, img.height = h;
   img.rgb.resize(size_t(w) * size_t(h) * 3);
-  for (size_t p = 0; p < img.rgb.size(); p += 3) img.rgb[p] = background.r, img.rgb[p + 1] = background.g, img.rgb[p + 2] = background.b;
+  for (size_t p = 0; p < img.rgb.size(); p += 3)
+    img.rgb[p] = background.r, img.rgb[p + 1] = background.g, img.rgb[p + 2] = background.b;
 }
 
 void Canvas::set(int x, int y, Rgb c) {

@@ -19,12 +19,12 @@ struct Rgb {
 enum class Marker { Circle, Square, Triangle, Diamond };
 
 struct Point {
-  double x = 0, y = 0;     ///< data units (must be > 0 on a log axis, else the point is skipped)
+  double x = 0, y = 0;  ///< data units (must be > 0 on a log axis, else the point is skipped)
   Rgb colour;
   Marker marker = Marker::Circle;
-  bool hollow = false;     ///< drawn as an outline (a second category, e.g. LOD window)
+  bool hollow = false;       ///< drawn as an outline (a second category, e.g. LOD window)
   bool highlighted = false;  ///< ringed in black (e.g. on the Pareto front)
-  std::string label;       ///< drawn next to the point when not empty and there is room
+  std::string label;         ///< drawn next to the point when not empty and there is room
 };
 
 struct LegendEntry {

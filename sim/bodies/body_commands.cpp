@@ -25,18 +25,27 @@ void World<S>::applyCommands(const TickInput& input) {
     wake(b);
     const Vec3<S> v = inputVector<S>(cmd.value);
     switch (cmd.kind) {
-      case BodyCommandKind::Displace: b.position += v; break;
-      case BodyCommandKind::AddVelocity: b.velocity += v; break;
-      case BodyCommandKind::Impulse: b.velocity += v * b.invMass; break;
+      case BodyCommandKind::Displace:
+        b.position += v;
+        break;
+      case BodyCommandKind::AddVelocity:
+        b.velocity += v;
+        break;
+      case BodyCommandKind::Impulse:
+        b.velocity += v * b.invMass;
+        break;
       case BodyCommandKind::Teleport:
         b.position = v;
         b.velocity = Vec3<S>::Zero();
         b.angularVelocity = Vec3<S>::Zero();
         break;
-      case BodyCommandKind::Reset: resetBody(size_t(cmd.body)); break;
+      case BodyCommandKind::Reset:
+        resetBody(size_t(cmd.body));
+        break;
       case BodyCommandKind::Spawn:
       case BodyCommandKind::MowerOn:
-      case BodyCommandKind::MowerOff: break;  // handled above
+      case BodyCommandKind::MowerOff:
+        break;  // handled above
     }
   }
 }
@@ -91,14 +100,13 @@ bool World<S>::bladeOn(int64_t body) const {
   return body >= 0 && body < int64_t(bodies_.size()) && bodies_[size_t(body)].mower && bodies_[size_t(body)].bladeOn;
 }
 
-
-#define SG_INSTANTIATE_COMMANDS(S) \
-  template void World<S>::applyCommands(const TickInput&); \
-  template void World<S>::resetBody(size_t); \
+#define SG_INSTANTIATE_COMMANDS(S)                              \
+  template void World<S>::applyCommands(const TickInput&);      \
+  template void World<S>::resetBody(size_t);                    \
   template void World<S>::spawnBody(int32_t, const InputVec3&); \
-  template void World<S>::dropCachedImpulses(size_t); \
-  template int32_t World<S>::bodyTemplate(int64_t) const; \
-  template bool World<S>::bladeOn(int64_t) const; \
+  template void World<S>::dropCachedImpulses(size_t);           \
+  template int32_t World<S>::bodyTemplate(int64_t) const;       \
+  template bool World<S>::bladeOn(int64_t) const;
 
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE_COMMANDS)
 

@@ -38,7 +38,8 @@ inline void integrateBodyPositions(std::vector<RigidBody<S>>& bodies, S dt) {
 /// angular speed both stay below the thresholds for `ticksToSleep` consecutive ticks falls asleep
 /// with zero velocities; it wakes when a command moves it or an awake body touches it.
 template <class S>
-inline void updateSleep(std::vector<RigidBody<S>>& bodies, S linearThreshold, S angularThreshold, int32_t ticksToSleep) {
+inline void updateSleep(std::vector<RigidBody<S>>& bodies, S linearThreshold, S angularThreshold,
+                        int32_t ticksToSleep) {
   const S lin2 = linearThreshold * linearThreshold, ang2 = angularThreshold * angularThreshold;
   for (RigidBody<S>& b : bodies) {
     if (!b.canSleep || b.asleep) continue;

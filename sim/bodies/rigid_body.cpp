@@ -12,7 +12,9 @@ S toS(const Rational& r) {
   return *v;
 }
 template <class S>
-Vec3<S> toS3(const Rational3& r) { return Vec3<S>(toS<S>(r[0]), toS<S>(r[1]), toS<S>(r[2])); }
+Vec3<S> toS3(const Rational3& r) {
+  return Vec3<S>(toS<S>(r[0]), toS<S>(r[1]), toS<S>(r[2]));
+}
 
 /// Checked exact arithmetic for the mass properties; an overflow names the body.
 struct Exact {
@@ -31,7 +33,7 @@ struct Exact {
 Rational volumeOf(const ShapeSpec& p, const Exact& x) {
   if (p.type == ShapeType::Sphere) {
     const Rational r3 = x.mul(x.mul(p.radius, p.radius), p.radius);
-    return x.mul(r3, Rational{1420, 339}  /* 4/3 pi with pi = 355/113 */);
+    return x.mul(r3, Rational{1420, 339} /* 4/3 pi with pi = 355/113 */);
   }
   return x.mul(x.mul(x.mul(p.halfExtents[0], p.halfExtents[1]), p.halfExtents[2]), Rational{8, 1});
 }
@@ -97,8 +99,8 @@ RigidBody<S> makeBody(const BodySpec& spec, const Rational& dt, const std::strin
   return b;
 }
 
-#define SG_INSTANTIATE(S)                                                   \
-  template RigidBody<S> makeBody<S>(const BodySpec&, const Rational&, const std::string&, const std::string&);     \
+#define SG_INSTANTIATE(S)                                                                                      \
+  template RigidBody<S> makeBody<S>(const BodySpec&, const Rational&, const std::string&, const std::string&); \
   template Quat<S> normalizedQuat<S>(const Quat<S>&);
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE)
 #undef SG_INSTANTIATE

@@ -14,31 +14,31 @@ namespace sg {
 template <class S>
 struct BodyPart {
   ShapeType type = ShapeType::Sphere;
-  S radius{};                               ///< m (sphere)
-  Vec3<S> halfExtents = Vec3<S>::Zero();    ///< m (box)
-  Vec3<S> offset = Vec3<S>::Zero();         ///< m, centre in the body frame (from the centre of mass)
-  S boundingRadius{};                       ///< m, around the part centre
+  S radius{};                             ///< m (sphere)
+  Vec3<S> halfExtents = Vec3<S>::Zero();  ///< m (box)
+  Vec3<S> offset = Vec3<S>::Zero();       ///< m, centre in the body frame (from the centre of mass)
+  S boundingRadius{};                     ///< m, around the part centre
 };
 
 template <class S>
 struct RigidBody {
   // --- constant properties -------------------------------------------------------------------
   std::vector<BodyPart<S>> parts;
-  S invMass{};                                 ///< 1/kg
-  Vec3<S> invInertiaLocal = Vec3<S>::Zero();   ///< principal inverse inertia (body axes), 1/(kg m^2)
+  S invMass{};                                          ///< 1/kg
+  Vec3<S> invInertiaLocal = Vec3<S>::Zero();            ///< principal inverse inertia (body axes), 1/(kg m^2)
   S linearDampingPerTick{1}, angularDampingPerTick{1};  ///< damping^dt
   S restitution{}, friction{};
-  S boundingRadius{};                          ///< m, around the centre of mass: covers every part
+  S boundingRadius{};  ///< m, around the centre of mass: covers every part
   bool mower = false;
   bool canSleep = true;
   // --- state (saved, hashed) -----------------------------------------------------------------
-  Vec3<S> position = Vec3<S>::Zero();          ///< centre of mass (m)
-  Quat<S> orientation = Quat<S>::Identity();   ///< unit quaternion, body -> world
-  Vec3<S> velocity = Vec3<S>::Zero();          ///< m/s
-  Vec3<S> angularVelocity = Vec3<S>::Zero();   ///< rad/s, world frame
-  int32_t stillTicks = 0;                      ///< consecutive ticks below the sleep thresholds
-  bool asleep = false;                         ///< skips gravity and integration until woken
-  bool bladeOn = true;                         ///< a mower cuts only while on (MowerOn/MowerOff)
+  Vec3<S> position = Vec3<S>::Zero();         ///< centre of mass (m)
+  Quat<S> orientation = Quat<S>::Identity();  ///< unit quaternion, body -> world
+  Vec3<S> velocity = Vec3<S>::Zero();         ///< m/s
+  Vec3<S> angularVelocity = Vec3<S>::Zero();  ///< rad/s, world frame
+  int32_t stillTicks = 0;                     ///< consecutive ticks below the sleep thresholds
+  bool asleep = false;                        ///< skips gravity and integration until woken
+  bool bladeOn = true;                        ///< a mower cuts only while on (MowerOn/MowerOff)
   // --- derived from the state (recomputed by updateDerived) ----------------------------------
   Mat3<S> rotation = Mat3<S>::Identity();
   Mat3<S> invInertiaWorld = Mat3<S>::Zero();

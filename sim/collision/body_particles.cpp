@@ -21,9 +21,11 @@ std::vector<ParticleRange> particleRanges(const std::vector<RigidBody<S>>& bodie
         const Vec3<S> c = body.partPose(p).position;
         const S reach = body.parts[p].boundingRadius + s.margin;
         r.a0 = std::max<int64_t>(w.originI, floorToInt((c.x() - reach - s.anchorOriginX) * s.invParticleSpacing));
-        r.a1 = std::min<int64_t>(w.endI() - 1, floorToInt((c.x() + reach - s.anchorOriginX) * s.invParticleSpacing) + 1);
+        r.a1 =
+            std::min<int64_t>(w.endI() - 1, floorToInt((c.x() + reach - s.anchorOriginX) * s.invParticleSpacing) + 1);
         r.b0 = std::max<int64_t>(w.originJ, floorToInt((c.z() - reach - s.anchorOriginZ) * s.invParticleSpacing));
-        r.b1 = std::min<int64_t>(w.endJ() - 1, floorToInt((c.z() + reach - s.anchorOriginZ) * s.invParticleSpacing) + 1);
+        r.b1 =
+            std::min<int64_t>(w.endJ() - 1, floorToInt((c.z() + reach - s.anchorOriginZ) * s.invParticleSpacing) + 1);
       }
       out.push_back(r);
     }
@@ -31,9 +33,10 @@ std::vector<ParticleRange> particleRanges(const std::vector<RigidBody<S>>& bodie
 }
 
 template <class S>
-int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid, const std::vector<RigidBody<S>>& bodies,
-                                 const std::vector<ParticleRange>& ranges, const BodyParticleSettings<S>& s,
-                                 int64_t rowBegin, int64_t rowEnd, int64_t* pushedPerBody) {
+int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid,
+                                 const std::vector<RigidBody<S>>& bodies, const std::vector<ParticleRange>& ranges,
+                                 const BodyParticleSettings<S>& s, int64_t rowBegin, int64_t rowEnd,
+                                 int64_t* pushedPerBody) {
   using T = ScalarTraits<S>;
   size_t rangeIndex = 0;
   for (size_t bodyIndex = 0; bodyIndex < bodies.size(); ++bodyIndex) {
@@ -89,12 +92,12 @@ int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid
   return -1;
 }
 
-#define SG_INSTANTIATE(S)                                                                                            \
-  template std::vector<ParticleRange> particleRanges(const std::vector<RigidBody<S>>&, const ParticleGrid&,          \
-                                                     const BodyParticleSettings<S>&);                                 \
+#define SG_INSTANTIATE(S)                                                                                              \
+  template std::vector<ParticleRange> particleRanges(const std::vector<RigidBody<S>>&, const ParticleGrid&,            \
+                                                     const BodyParticleSettings<S>&);                                  \
   template int64_t pushParticlesOutOfBodies(ParticleArrays<S>&, const ParticleGrid&, const std::vector<RigidBody<S>>&, \
-                                            const std::vector<ParticleRange>&, const BodyParticleSettings<S>&, int64_t, int64_t, \
-                                            int64_t*);
+                                            const std::vector<ParticleRange>&, const BodyParticleSettings<S>&,         \
+                                            int64_t, int64_t, int64_t*);
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE)
 #undef SG_INSTANTIATE
 }  // namespace sg

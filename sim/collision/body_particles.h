@@ -32,9 +32,9 @@ struct BodyParticleSettings {
   BoxParticleNormal boxNormal = BoxParticleNormal::Up;
   ParticleBroadphase broadphase = ParticleBroadphase::Grid;
   S particleInvMass{1};
-  S margin{};                 ///< m, see above
+  S margin{};                          ///< m, see above
   S anchorOriginX{}, anchorOriginZ{};  ///< m, un-jittered position of particle (0, 0)
-  S invParticleSpacing{};     ///< 1 / (k spacing)
+  S invParticleSpacing{};              ///< 1 / (k spacing)
 };
 
 /// Candidate ranges for every body part, in (body, part) order.

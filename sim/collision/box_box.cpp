@@ -43,16 +43,24 @@ template <class S>
 Tolerances<S> tolerances() {
   Tolerances<S> t;
   switch (ScalarTraits<S>::kind) {
-    case ScalarKind::Fx32: t.roundoff = pow2neg<S>(28); break;    // ulp 2^-32
-    case ScalarKind::Fx16: t.roundoff = pow2neg<S>(12); break;    // ulp 2^-16
-    case ScalarKind::Float: t.roundoff = pow2neg<S>(19); break;   // ulp(1) 2^-23
-    case ScalarKind::Double: t.roundoff = pow2neg<S>(48); break;  // ulp(1) 2^-52
+    case ScalarKind::Fx32:
+      t.roundoff = pow2neg<S>(28);
+      break;  // ulp 2^-32
+    case ScalarKind::Fx16:
+      t.roundoff = pow2neg<S>(12);
+      break;  // ulp 2^-16
+    case ScalarKind::Float:
+      t.roundoff = pow2neg<S>(19);
+      break;  // ulp(1) 2^-23
+    case ScalarKind::Double:
+      t.roundoff = pow2neg<S>(48);
+      break;  // ulp(1) 2^-52
   }
   // The edge contact point errs by about ulp / sin^2 (the closest-point formula divides a
   // rounded dot product by |L|^2): fx16 needs a larger floor to keep that below ~5 mm.
   t.edgeMinSin = ScalarTraits<S>::kind == ScalarKind::Fx16 ? pow2neg<S>(4) : pow2neg<S>(10);
-  t.faceRel = pow2neg<S>(6);   // 1.6 %, cf. Box2D 2.x k_relativeTol = 0.98
-  t.edgeRel = pow2neg<S>(4);   // 6.25 %, cf. ODE's fudge factor 1.05 on edge axes
+  t.faceRel = pow2neg<S>(6);  // 1.6 %, cf. Box2D 2.x k_relativeTol = 0.98
+  t.edgeRel = pow2neg<S>(4);  // 6.25 %, cf. ODE's fudge factor 1.05 on edge axes
   return t;
 }
 
@@ -134,8 +142,7 @@ struct SatResult {
 };
 
 template <class S>
-SatResult<S> separatingAxisTest(const Relative<S>& rel, const Vec3<S>& ha, const Vec3<S>& hb, S margin,
-                                S edgeMinSin) {
+SatResult<S> separatingAxisTest(const Relative<S>& rel, const Vec3<S>& ha, const Vec3<S>& hb, S margin, S edgeMinSin) {
   using std::abs;
   SatResult<S> r;
   // Faces of A: axis a_i. B's projection radius is sum_j hb_j |a_i . b_j|.
@@ -161,7 +168,7 @@ SatResult<S> separatingAxisTest(const Relative<S>& rel, const Vec3<S>& ha, const
     for (int j = 0; j < 3; ++j) {
       const EdgeAxis<S> e = edgeAxis(rel, ha, hb, i, j);
       if (e.overlapU + margin < S(0)) return {true, {}, {}, {}};
-      if (e.len < edgeMinSin) continue;  // (near) parallel edges: no contact axis
+      if (e.len < edgeMinSin) continue;                               // (near) parallel edges: no contact axis
       const S pen = (e.overlapU < S(0) ? S(0) : e.overlapU) / e.len;  // len >= edgeMinSin > 0
       if (r.edge.index < 0 || pen < r.edge.pen) r.edge = {6 + 3 * i + j, pen};
     }
@@ -382,9 +389,9 @@ int collideBoxBox(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, int32_t b, co
   return 0;
 }
 
-#define SG_INSTANTIATE(S)                                                                          \
-  template int collideBoxBox(int32_t, const Vec3<S>&, const Pose<S>&, int32_t, const Vec3<S>&, \
-                             const Pose<S>&, std::vector<Contact<S>>&);
+#define SG_INSTANTIATE(S)                                                                                      \
+  template int collideBoxBox(int32_t, const Vec3<S>&, const Pose<S>&, int32_t, const Vec3<S>&, const Pose<S>&, \
+                             std::vector<Contact<S>>&);
 SG_INSTANTIATE(Fx32)
 SG_INSTANTIATE(Fx16)
 SG_INSTANTIATE(float)

@@ -49,8 +49,7 @@ inline constexpr uint32_t kBoxIncidentFaceStride = 0x100;
 /// within +-1000 m (fx32, float, double) or +-100 m (fx16); rotations proper (det +1) and
 /// orthonormal to the scalar's precision. No division by zero, no fixed-point fault there.
 template <class S>
-int collideBoxBox(int32_t a, const Vec3<S>& ha, const Pose<S>& pa,
-                  int32_t b, const Vec3<S>& hb, const Pose<S>& pb,
+int collideBoxBox(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, int32_t b, const Vec3<S>& hb, const Pose<S>& pb,
                   std::vector<Contact<S>>& out);
 
 }  // namespace sg

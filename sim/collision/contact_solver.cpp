@@ -9,10 +9,10 @@ namespace {
 
 template <class S>
 struct VelocityRow {
-  Vec3<S> rA, rB;         // contact point relative to the centres of mass
+  Vec3<S> rA, rB;  // contact point relative to the centres of mass
   Vec3<S> normal, t1, t2;
   S massN{}, massT1{}, massT2{};  // 1 / effective mass along each direction
-  S target{};             // desired separating normal velocity
+  S target{};                     // desired separating normal velocity
   S friction{};
   S impulseN{}, impulseT1{}, impulseT2{};  // accumulated
   int32_t a = 0, b = kTerrainBody;
@@ -58,7 +58,9 @@ void applyPair(std::vector<RigidBody<S>>& bodies, const VelocityRow<S>& row, con
 
 /// 1 / k, or 0 when k is not positive (an immovable direction).
 template <class S>
-S invertPositive(S k) { return k > S(0) ? S(1) / k : S(0); }
+S invertPositive(S k) {
+  return k > S(0) ? S(1) / k : S(0);
+}
 
 }  // namespace
 
@@ -250,7 +252,7 @@ void solveContactPositions(std::vector<RigidBody<S>>& bodies, const std::vector<
       }
       const Vec3<S> dp = normal * linearMove;
       const Vec3<S> dTheta = angularInertia[k] > S(0) ? Vec3<S>(angularPerUnit[k] * (angularMove / angularInertia[k]))
-                                                     : Vec3<S>(Vec3<S>::Zero());
+                                                      : Vec3<S>(Vec3<S>::Zero());
       body.position += dp;
       const Quat<S> spin(S(0), dTheta.x(), dTheta.y(), dTheta.z());
       Quat<S> q = body.orientation;
@@ -266,11 +268,12 @@ void solveContactPositions(std::vector<RigidBody<S>>& bodies, const std::vector<
   }
 }
 
-#define SG_INSTANTIATE(S)                                                                                           \
-  template void sortContacts(std::vector<Contact<S>>&);                                                             \
-  template void solveContactVelocities(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&,                 \
-                                       const SolverSettings<S>&, std::vector<CachedImpulse<S>>&);                   \
-  template void solveContactPositions(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&, const SolverSettings<S>&);
+#define SG_INSTANTIATE(S)                                                                          \
+  template void sortContacts(std::vector<Contact<S>>&);                                            \
+  template void solveContactVelocities(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&, \
+                                       const SolverSettings<S>&, std::vector<CachedImpulse<S>>&);  \
+  template void solveContactPositions(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&,  \
+                                      const SolverSettings<S>&);
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE)
 #undef SG_INSTANTIATE
 }  // namespace sg

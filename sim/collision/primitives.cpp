@@ -80,7 +80,8 @@ int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Ter
   int added = 0;
   // 1. Corners below the terrain (thesis).
   for (uint32_t corner = 0; corner < 8; ++corner) {
-    const Vec3<S> local((corner & 1) ? ha.x() : -ha.x(), (corner & 2) ? ha.y() : -ha.y(), (corner & 4) ? ha.z() : -ha.z());
+    const Vec3<S> local((corner & 1) ? ha.x() : -ha.x(), (corner & 2) ? ha.y() : -ha.y(),
+                        (corner & 4) ? ha.z() : -ha.z());
     const Vec3<S> p = pa.toWorld(local);
     const S h = terrain.heightAt(p.x(), p.z());
     if (p.y() >= h) continue;
@@ -121,11 +122,11 @@ int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Ter
   return added;
 }
 
-#define SG_INSTANTIATE(S)                                                                                          \
+#define SG_INSTANTIATE(S)                                                                                             \
   template int collideSphereSphere(int32_t, const Vec3<S>&, S, int32_t, const Vec3<S>&, S, std::vector<Contact<S>>&); \
-  template int collideSphereBox(int32_t, const Vec3<S>&, S, int32_t, const Vec3<S>&, const Pose<S>&,               \
-                                std::vector<Contact<S>>&);                                                         \
-  template int collideSphereTerrain(int32_t, const Vec3<S>&, S, const Terrain<S>&, std::vector<Contact<S>>&);      \
+  template int collideSphereBox(int32_t, const Vec3<S>&, S, int32_t, const Vec3<S>&, const Pose<S>&,                  \
+                                std::vector<Contact<S>>&);                                                            \
+  template int collideSphereTerrain(int32_t, const Vec3<S>&, S, const Terrain<S>&, std::vector<Contact<S>>&);         \
   template int collideBoxTerrain(int32_t, const Vec3<S>&, const Pose<S>&, const Terrain<S>&, std::vector<Contact<S>>&);
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE)
 #undef SG_INSTANTIATE

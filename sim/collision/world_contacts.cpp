@@ -50,7 +50,6 @@ bool World<S>::bodiesFaulted(Stage stage) {
   return false;
 }
 
-
 template <class S>
 bool World<S>::respondToContacts() {
   applyGravity(bodies_, gravityDt_);
@@ -80,11 +79,10 @@ bool World<S>::respondToContacts() {
   return !bodiesFaulted(Stage::Response);
 }
 
-
-#define SG_INSTANTIATE_CONTACTS(S) \
-  template void World<S>::detectContacts(); \
+#define SG_INSTANTIATE_CONTACTS(S)              \
+  template void World<S>::detectContacts();     \
   template bool World<S>::bodiesFaulted(Stage); \
-  template bool World<S>::respondToContacts(); \
+  template bool World<S>::respondToContacts();
 
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE_CONTACTS)
 

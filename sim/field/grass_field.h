@@ -17,7 +17,7 @@ template <class S>
 struct GrassLattice {
   int64_t patchesX = 0, patchesZ = 0;
   S spacing{};
-  S jitterAmplitude{};  ///< m: jitter is uniform in [-amplitude, +amplitude]
+  S jitterAmplitude{};     ///< m: jitter is uniform in [-amplitude, +amplitude]
   S originX{}, originZ{};  ///< m: un-jittered position of patch (0, 0)
   uint64_t seed = 0;
   int atlasVariants = 4;
@@ -28,9 +28,7 @@ struct GrassLattice {
     *x = originX + mulInt(spacing, i) + jitterAmplitude * (ux + ux - S(1));
     *z = originZ + mulInt(spacing, j) + jitterAmplitude * (uz + uz - S(1));
   }
-  uint16_t rotation(int64_t i, int64_t j) const {
-    return uint16_t(latticeHash(i, j, seed, LatticeSalt::Appearance));
-  }
+  uint16_t rotation(int64_t i, int64_t j) const { return uint16_t(latticeHash(i, j, seed, LatticeSalt::Appearance)); }
   uint8_t variant(int64_t i, int64_t j) const {
     return uint8_t((latticeHash(i, j, seed, LatticeSalt::Appearance) >> 16) % uint64_t(atlasVariants));
   }

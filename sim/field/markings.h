@@ -21,7 +21,7 @@ struct FieldMarkings {
     const bool insideOuter = dx <= halfLength + halfLine && dz <= halfWidth + halfLine;
     if (!insideOuter) return false;
     if (abs(dx - halfLength) <= halfLine || abs(dz - halfWidth) <= halfLine) return true;  // boundary
-    if (dx <= halfLine) return true;                                                     // halfway line
+    if (dx <= halfLine) return true;                                                       // halfway line
     // Centre circle: compare squared distances (no square root): (r - w)^2 <= d^2 <= (r + w)^2.
     if (dx > circleRadius + halfLine || dz > circleRadius + halfLine) return false;
     const S d2 = dx * dx + dz * dz;

@@ -38,8 +38,8 @@ struct EdgeRing {
   void configure(const GrassLattice<S>& grass, int64_t spacingMultiple, int64_t rows);
   /// Follows the simulation window `window` (fine patches): regenerates the cells that enter.
   template <class IsCut>
-  void follow(const LatticeWindow& window, const Terrain<S>& terrain, const FieldMarkings<S>& markings,
-              IsCut&& isCut, bool everything);
+  void follow(const LatticeWindow& window, const Terrain<S>& terrain, const FieldMarkings<S>& markings, IsCut&& isCut,
+              bool everything);
   /// The grass patch at the centre of coarse cell (a, b).
   int64_t centrePatchI(int64_t a) const { return a * spacingMultiple + spacingMultiple / 2; }
   int64_t centrePatchJ(int64_t b) const { return b * spacingMultiple + spacingMultiple / 2; }

@@ -44,7 +44,8 @@ struct LatticeWindow {
 /// that `before` did not hold, or for all of them when `everything`: what enters a window when it
 /// moves from `before` to `now`. Rows are independent, so callers may run them in parallel.
 template <class Fn>
-void forEachEnteringCell(const LatticeWindow& now, const LatticeWindow& before, bool everything, int64_t r, Fn&& enter) {
+void forEachEnteringCell(const LatticeWindow& now, const LatticeWindow& before, bool everything, int64_t r,
+                         Fn&& enter) {
   const int64_t j = now.originJ + r;
   const bool rowWasHeld = !everything && j >= before.originJ && j < before.endJ();
   if (!rowWasHeld) {

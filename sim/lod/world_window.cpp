@@ -75,8 +75,12 @@ void World<S>::moveWindowTo(int64_t originI, int64_t originJ, bool initialVeloci
   fill(grid_.window, oldParticles, [&](int64_t I, int64_t J) { initParticle(I, J, initialVelocity); });
   fill(patchWindow_, oldPatches, [&](int64_t i, int64_t j) { initPatch(i, j); });
   if (lodWindow_)
-    edgeRing_.follow(patchWindow_, terrain_, markings_, [&](int64_t i, int64_t j) { return cuts_.count({i, j}) > 0; },
-                     everything);
+    edgeRing_.follow(
+        patchWindow_, terrain_, markings_,
+        [&](int64_t i, int64_t j) {
+          return cuts_.count({i, j}) > 0;
+        },
+        everything);
 }
 
 template <class S>
@@ -98,15 +102,14 @@ void World<S>::followCamera(const InputVec3& camera) {
   if (I0 != grid_.window.originI || J0 != grid_.window.originJ) moveWindowTo(I0, J0, false, false);
 }
 
-
-#define SG_INSTANTIATE_WINDOW(S) \
-  template int64_t World<S>::nearestParticleColumn(S, S) const; \
-  template int64_t World<S>::clampWindowOrigin(int64_t, bool) const; \
-  template void World<S>::initParticle(int64_t, int64_t, bool); \
-  template void World<S>::initPatch(int64_t, int64_t); \
-  template void World<S>::fillWindow(int64_t, int64_t, bool); \
+#define SG_INSTANTIATE_WINDOW(S)                                      \
+  template int64_t World<S>::nearestParticleColumn(S, S) const;       \
+  template int64_t World<S>::clampWindowOrigin(int64_t, bool) const;  \
+  template void World<S>::initParticle(int64_t, int64_t, bool);       \
+  template void World<S>::initPatch(int64_t, int64_t);                \
+  template void World<S>::fillWindow(int64_t, int64_t, bool);         \
   template void World<S>::moveWindowTo(int64_t, int64_t, bool, bool); \
-  template void World<S>::followCamera(const InputVec3&); \
+  template void World<S>::followCamera(const InputVec3&);
 
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE_WINDOW)
 

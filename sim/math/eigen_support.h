@@ -17,19 +17,33 @@
 
 namespace sg {
 template <class R, class W, int F>
-constexpr Fixed<R, W, F> abs2(Fixed<R, W, F> a) noexcept { return a * a; }
+constexpr Fixed<R, W, F> abs2(Fixed<R, W, F> a) noexcept {
+  return a * a;
+}
 template <class R, class W, int F>
-constexpr Fixed<R, W, F> conj(Fixed<R, W, F> a) noexcept { return a; }
+constexpr Fixed<R, W, F> conj(Fixed<R, W, F> a) noexcept {
+  return a;
+}
 template <class R, class W, int F>
-constexpr Fixed<R, W, F> real(Fixed<R, W, F> a) noexcept { return a; }
+constexpr Fixed<R, W, F> real(Fixed<R, W, F> a) noexcept {
+  return a;
+}
 template <class R, class W, int F>
-constexpr Fixed<R, W, F> imag(Fixed<R, W, F>) noexcept { return {}; }
+constexpr Fixed<R, W, F> imag(Fixed<R, W, F>) noexcept {
+  return {};
+}
 template <class R, class W, int F>
-constexpr bool isfinite(Fixed<R, W, F>) noexcept { return true; }
+constexpr bool isfinite(Fixed<R, W, F>) noexcept {
+  return true;
+}
 template <class R, class W, int F>
-constexpr bool isnan(Fixed<R, W, F>) noexcept { return false; }
+constexpr bool isnan(Fixed<R, W, F>) noexcept {
+  return false;
+}
 template <class R, class W, int F>
-constexpr bool isinf(Fixed<R, W, F>) noexcept { return false; }
+constexpr bool isinf(Fixed<R, W, F>) noexcept {
+  return false;
+}
 }  // namespace sg
 
 namespace Eigen {
@@ -62,7 +76,10 @@ struct NumTraits<sg::Fixed<R, W, F>> : GenericNumTraits<sg::Fixed<R, W, F>> {
 }  // namespace Eigen
 
 namespace sg {
-template <class S> using Vec3 = Eigen::Matrix<S, 3, 1>;
-template <class S> using Mat3 = Eigen::Matrix<S, 3, 3>;
-template <class S> using Quat = Eigen::Quaternion<S>;
+template <class S>
+using Vec3 = Eigen::Matrix<S, 3, 1>;
+template <class S>
+using Mat3 = Eigen::Matrix<S, 3, 3>;
+template <class S>
+using Quat = Eigen::Quaternion<S>;
 }  // namespace sg

@@ -306,7 +306,10 @@ inline Fixed<R, W, F> sqrtWith(Fixed<R, W, F> a) noexcept {
 template <class U, class R, class W, int F>
 inline Fixed<R, W, F> length3With(Fixed<R, W, F> x, Fixed<R, W, F> y, Fixed<R, W, F> z) noexcept {
   using Fx = Fixed<R, W, F>;
-  auto sq = [](R v) { const U m = v < 0 ? U(0) - U(v) : U(v); return m * m; };
+  auto sq = [](R v) {
+    const U m = v < 0 ? U(0) - U(v) : U(v);
+    return m * m;
+  };
   // Each square is < 2^(2*bits-2), so the sum of three fits in 2*bits unsigned bits.
   const uint64_t r = isqrtNearest(sq(x.raw()) + sq(y.raw()) + sq(z.raw()));
   if (r > uint64_t(std::numeric_limits<R>::max())) raiseFixedFault(kFixedFaultOverflow);

@@ -214,14 +214,14 @@ class UInt128 {
     // d >= 2^64, so the quotient fits 64 bits (Hacker's Delight, 2nd ed., fig. 9-5): divide
     // n / 2 by the divisor's normalised top 64 bits, undo the normalisation; the estimate is
     // then the quotient or one above it (decrement), and one correction step makes it exact.
-    const int s = std::countl_zero(d.hi_);        // 0..63
-    const uint64_t v1 = (d << s).hi_;              // top bit set
-    const UInt128 u1 = n >> 1;                     // u1.hi < 2^63 <= v1: one divlu step
+    const int s = std::countl_zero(d.hi_);  // 0..63
+    const uint64_t v1 = (d << s).hi_;       // top bit set
+    const UInt128 u1 = n >> 1;              // u1.hi < 2^63 <= v1: one divlu step
     uint64_t unused = 0;
     const uint64_t q1 = detail::divlu(u1.hi_, u1.lo_, v1, &unused);
     uint64_t q0 = ((UInt128(q1) << s) >> 63).lo_;  // < 2^64 here
     if (q0 != 0) --q0;
-    UInt128 r = n - UInt128(q0) * d;               // q0 <= the true quotient: no wrap
+    UInt128 r = n - UInt128(q0) * d;  // q0 <= the true quotient: no wrap
     if (r >= d) {
       ++q0;
       r = r - d;
@@ -368,8 +368,7 @@ using UnsignedOfT = typename UnsignedOf<T>::type;
 
 /// True for the portable struct types (the fast paths with builtin-only code skip them).
 template <class T>
-inline constexpr bool kIsPortableInt128 =
-    std::is_same_v<T, portable::Int128> || std::is_same_v<T, portable::UInt128>;
+inline constexpr bool kIsPortableInt128 = std::is_same_v<T, portable::Int128> || std::is_same_v<T, portable::UInt128>;
 
 inline constexpr UInt128 kUInt128Max = ~UInt128(0);
 inline constexpr Int128 kInt128Max = Int128(kUInt128Max >> 1);

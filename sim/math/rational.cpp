@@ -1,8 +1,8 @@
 #include "sim/math/rational.h"
 
-#include <cctype>
 #include <algorithm>
 #include <bit>
+#include <cctype>
 #include <cmath>
 #include <limits>
 
@@ -57,8 +57,8 @@ std::optional<Rational> parseDecimal(std::string_view t, std::string* error) {
   bool neg = false;
   if (i < t.size() && (t[i] == '-' || t[i] == '+')) neg = t[i++] == '-';
   I128 mant = 0;
-  int digits = 0, scale = 0;           // value = mant * 10^(-scale) * 10^pendingInt
-  int pendingInt = 0, pendingFrac = 0; // zeros seen after the last non-zero digit
+  int digits = 0, scale = 0;            // value = mant * 10^(-scale) * 10^pendingInt
+  int pendingInt = 0, pendingFrac = 0;  // zeros seen after the last non-zero digit
   bool any = false, dot = false;
   for (; i < t.size(); ++i) {
     const char c = t[i];
@@ -149,8 +149,7 @@ std::optional<Rational> add(const Rational& a, const Rational& b) {
   const I128 g = gcd(a.den, b.den);
   const I128 ad = a.den / g, bd = b.den / g;
   I128 x, y, d, n;
-  if (!mulChecked(a.num, bd, &x) || !mulChecked(b.num, ad, &y) || !mulChecked(a.den, bd, &d) ||
-      addOverflow(x, y, &n))
+  if (!mulChecked(a.num, bd, &x) || !mulChecked(b.num, ad, &y) || !mulChecked(a.den, bd, &d) || addOverflow(x, y, &n))
     return std::nullopt;
   return Rational::make(n, d);
 }
@@ -309,9 +308,12 @@ Rational deterministicPow(const Rational& base, const Rational& exponent) {
   I128 m = 0;
   for (int tries = 0; tries < 4; ++tries) {
     m = *base.toScaledInteger(kQ + e);  // base * 2^(62 + e) < 2^63: always fits
-    if (m < kOne / 2) ++e;
-    else if (m >= kOne) --e;
-    else break;
+    if (m < kOne / 2)
+      ++e;
+    else if (m >= kOne)
+      --e;
+    else
+      break;
   }
   const I128 lnBase = lnReduced(m) - I128(e) * ln2();  // <= 0, |lnBase| < 2^70
   // x = exponent * ln(base). An x too large for 128 bits means base^exponent < 2^-(2^35): 0.

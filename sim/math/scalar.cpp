@@ -3,10 +3,14 @@
 namespace sg {
 const char* scalarName(ScalarKind kind) {
   switch (kind) {
-    case ScalarKind::Fx32: return "fx32";
-    case ScalarKind::Fx16: return "fx16";
-    case ScalarKind::Float: return "float";
-    case ScalarKind::Double: return "double";
+    case ScalarKind::Fx32:
+      return "fx32";
+    case ScalarKind::Fx16:
+      return "fx16";
+    case ScalarKind::Float:
+      return "float";
+    case ScalarKind::Double:
+      return "double";
   }
   return "?";
 }

@@ -32,7 +32,8 @@ struct FixedTraits {
   static constexpr bool isFixed = true;
   /// Largest coordinate magnitude a scenario may use: a quarter of the range, so that sums and
   /// differences of two coordinates (and a rod length) can never overflow.
-  static constexpr double maxCoordinate = double(std::numeric_limits<typename Fx::RawType>::max() >> Fx::kFracBits) / 4.0;
+  static constexpr double maxCoordinate =
+      double(std::numeric_limits<typename Fx::RawType>::max() >> Fx::kFracBits) / 4.0;
   static std::optional<Fx> fromRational(const Rational& r) {
     const auto v = r.toScaledInteger(Fx::kFracBits);
     using Raw = typename Fx::RawType;
@@ -57,15 +58,27 @@ struct FloatTraits {
   static bool faultPending() { return false; }
   static bool isFinite(F v) { return std::isfinite(v); }
   using Bits = B;
-  static Bits bits(F v) { Bits b; std::memcpy(&b, &v, sizeof b); return b; }
-  static F fromBits(Bits b) { F v; std::memcpy(&v, &b, sizeof v); return v; }
+  static Bits bits(F v) {
+    Bits b;
+    std::memcpy(&b, &v, sizeof b);
+    return b;
+  }
+  static F fromBits(Bits b) {
+    F v;
+    std::memcpy(&v, &b, sizeof v);
+    return v;
+  }
 };
 }  // namespace detail
 
-template <> struct ScalarTraits<Fx32> : detail::FixedTraits<Fx32, ScalarKind::Fx32> {};
-template <> struct ScalarTraits<Fx16> : detail::FixedTraits<Fx16, ScalarKind::Fx16> {};
-template <> struct ScalarTraits<float> : detail::FloatTraits<float, ScalarKind::Float, uint32_t> {};
-template <> struct ScalarTraits<double> : detail::FloatTraits<double, ScalarKind::Double, uint64_t> {};
+template <>
+struct ScalarTraits<Fx32> : detail::FixedTraits<Fx32, ScalarKind::Fx32> {};
+template <>
+struct ScalarTraits<Fx16> : detail::FixedTraits<Fx16, ScalarKind::Fx16> {};
+template <>
+struct ScalarTraits<float> : detail::FloatTraits<float, ScalarKind::Float, uint32_t> {};
+template <>
+struct ScalarTraits<double> : detail::FloatTraits<double, ScalarKind::Double, uint64_t> {};
 
 // float/double counterparts of the fixed-point free functions, so kernels are written once.
 // sqrt is IEEE correctly rounded (and an instruction with -fno-math-errno): deterministic.
@@ -81,10 +94,14 @@ inline double length3(double x, double y, double z) { return std::sqrt(x * x + y
 template <class F>
 decltype(auto) dispatchScalar(ScalarKind kind, F&& f) {
   switch (kind) {
-    case ScalarKind::Fx16: return f.template operator()<Fx16>();
-    case ScalarKind::Float: return f.template operator()<float>();
-    case ScalarKind::Double: return f.template operator()<double>();
-    case ScalarKind::Fx32: break;
+    case ScalarKind::Fx16:
+      return f.template operator()<Fx16>();
+    case ScalarKind::Float:
+      return f.template operator()<float>();
+    case ScalarKind::Double:
+      return f.template operator()<double>();
+    case ScalarKind::Fx32:
+      break;
   }
   return f.template operator()<Fx32>();
 }

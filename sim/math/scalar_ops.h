@@ -47,13 +47,19 @@ inline S unitFromBits(uint32_t bits) {
 }
 
 template <class S>
-inline S minS(S a, S b) { return b < a ? b : a; }
+inline S minS(S a, S b) {
+  return b < a ? b : a;
+}
 template <class S>
-inline S maxS(S a, S b) { return a < b ? b : a; }
+inline S maxS(S a, S b) {
+  return a < b ? b : a;
+}
 
 /// a + (b - a) * t: linear interpolation; exact at t = 0 for every scalar.
 template <class S>
-inline S lerp(S a, S b, S t) { return a + (b - a) * t; }
+inline S lerp(S a, S b, S t) {
+  return a + (b - a) * t;
+}
 
 }  // namespace sg
 

@@ -41,8 +41,8 @@ inline int64_t integrateParticleRow(ParticleArrays<S>& p, int64_t begin, int64_t
       py[i] += vy[i] * dt;
       pz[i] += vz[i] * dt;
     }
-    if (T::faultPending() || !(T::isFinite(px[i]) && T::isFinite(py[i]) && T::isFinite(pz[i]) &&
-                               T::isFinite(vx[i]) && T::isFinite(vy[i]) && T::isFinite(vz[i])))
+    if (T::faultPending() || !(T::isFinite(px[i]) && T::isFinite(py[i]) && T::isFinite(pz[i]) && T::isFinite(vx[i]) &&
+                               T::isFinite(vy[i]) && T::isFinite(vz[i])))
       return i;
   }
   return -1;

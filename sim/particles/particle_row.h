@@ -30,8 +30,6 @@ struct RowFault {
   Stage stage = Stage::Integrate;
 };
 
-
-
 /// The reference: integrates, projects and measures particles [begin, end) of one row;
 /// (dvx, dvy, dvz) is the row's (a + F/m) dt. Writes the tip displacement p - anchor - (0, L, 0)
 /// into (dx, dy, dz). A fault stops the row at the faulting particle, in the stage that raised
@@ -57,10 +55,11 @@ RowFault advanceParticleRowAvx2(ParticleArrays<S>& p, int64_t begin, int64_t end
 /// The fused pass with the chosen kernel (float and double always run the reference).
 template <class S, bool Pbd>
 inline RowFault advanceParticleRow(ParticleKernel kernel, ParticleArrays<S>& p, int64_t begin, int64_t end, S dvx,
-                                   S dvy, S dvz, const ParticleConstants<S>& c, std::vector<S>& dx,
-                                   std::vector<S>& dy, std::vector<S>& dz) {
+                                   S dvy, S dvz, const ParticleConstants<S>& c, std::vector<S>& dx, std::vector<S>& dy,
+                                   std::vector<S>& dz) {
   if constexpr (ScalarTraits<S>::isFixed)
-    if (kernel == ParticleKernel::Avx2) return advanceParticleRowAvx2<S, Pbd>(p, begin, end, dvx, dvy, dvz, c, dx, dy, dz);
+    if (kernel == ParticleKernel::Avx2)
+      return advanceParticleRowAvx2<S, Pbd>(p, begin, end, dvx, dvy, dvz, c, dx, dy, dz);
   return advanceParticleRowScalar<S, Pbd>(p, begin, end, dvx, dvy, dvz, c, dx, dy, dz);
 }
 

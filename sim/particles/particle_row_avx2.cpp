@@ -120,8 +120,8 @@ SG_AVX2 __m256i squareLow(__m256i x) {
 }
 /// a b mod 2^64 for a, b >= 0.
 SG_AVX2 __m256i productLow(__m256i a, __m256i b) {
-  const __m256i cross = _mm256_add_epi64(_mm256_mul_epu32(_mm256_srli_epi64(a, 32), b),
-                                         _mm256_mul_epu32(a, _mm256_srli_epi64(b, 32)));
+  const __m256i cross =
+      _mm256_add_epi64(_mm256_mul_epu32(_mm256_srli_epi64(a, 32), b), _mm256_mul_epu32(a, _mm256_srli_epi64(b, 32)));
   return _mm256_add_epi64(_mm256_mul_epu32(a, b), _mm256_slli_epi64(cross, 32));
 }
 
@@ -168,8 +168,8 @@ __attribute__((target("avx2"))) bool makeRowConstants(const ParticleConstants<Fx
 
 /// Particles [i, i + 4). Returns false, having written nothing, when a lane needs the reference.
 template <bool Pbd, bool Narrow>
-__attribute__((target("avx2"))) bool advanceBlock(ParticleArrays<Fx32>& p, int64_t i, const RowConstants& k,
-                                                  Fx32* outX, Fx32* outY, Fx32* outZ) {
+__attribute__((target("avx2"))) bool advanceBlock(ParticleArrays<Fx32>& p, int64_t i, const RowConstants& k, Fx32* outX,
+                                                  Fx32* outY, Fx32* outZ) {
   Flags slow = Flags::none();
   __m256i px = load(&p.px[i]), py = load(&p.py[i]), pz = load(&p.pz[i]);
   __m256i vx = load(&p.vx[i]), vy = load(&p.vy[i]), vz = load(&p.vz[i]);
@@ -298,17 +298,22 @@ __attribute__((target("avx2"))) bool makeRowConstants(const ParticleConstants<Fx
   const int32_t rod = c.rodLength.raw();
   if (c.dt.raw() < 0 || c.dampingPerTick.raw() < 0 || c.invDt.raw() < 0 || rod <= 0) return false;
   const int64_t numerator = int64_t(rod) << 16;
-  k = RowConstants{all32(c.dt.raw()),   all32(c.dampingPerTick.raw()), all32(c.invDt.raw()),
-                   all32(dvx.raw()),    all32(dvy.raw()),              all32(dvz.raw()),
-                   all32(rod),          all32(int32_t(uint32_t(uint64_t(numerator)))),
+  k = RowConstants{all32(c.dt.raw()),
+                   all32(c.dampingPerTick.raw()),
+                   all32(c.invDt.raw()),
+                   all32(dvx.raw()),
+                   all32(dvy.raw()),
+                   all32(dvz.raw()),
+                   all32(rod),
+                   all32(int32_t(uint32_t(uint64_t(numerator)))),
                    _mm256_set1_pd(double(numerator))};
   return true;
 }
 
 /// Particles [i, i + 8). Returns false, having written nothing, when a lane needs the reference.
 template <bool Pbd>
-__attribute__((target("avx2"))) bool advanceBlock(ParticleArrays<Fx16>& p, int64_t i, const RowConstants& k,
-                                                  Fx16* outX, Fx16* outY, Fx16* outZ) {
+__attribute__((target("avx2"))) bool advanceBlock(ParticleArrays<Fx16>& p, int64_t i, const RowConstants& k, Fx16* outX,
+                                                  Fx16* outY, Fx16* outZ) {
   __m256i slow = _mm256_setzero_si256();  // any set bit: the block needs the reference
   __m256i px = load(&p.px[i]), py = load(&p.py[i]), pz = load(&p.pz[i]);
   __m256i vx = load(&p.vx[i]), vy = load(&p.vy[i]), vz = load(&p.vz[i]);
@@ -469,10 +474,12 @@ ParticleKernel defaultParticleKernel() {
   return wanted == ParticleKernel::Avx2 && avx2KernelAvailable() ? ParticleKernel::Avx2 : ParticleKernel::Scalar;
 }
 
-void setDefaultParticleKernel(ParticleKernel kernel) { gDefaultKernel.store(uint8_t(kernel), std::memory_order_relaxed); }
+void setDefaultParticleKernel(ParticleKernel kernel) {
+  gDefaultKernel.store(uint8_t(kernel), std::memory_order_relaxed);
+}
 
-#define SG_INSTANTIATE_AVX2_ROW(S, PBD)                                                                              \
-  template RowFault advanceParticleRowAvx2<S, PBD>(ParticleArrays<S>&, int64_t, int64_t, S, S, S,                  \
+#define SG_INSTANTIATE_AVX2_ROW(S, PBD)                                                                           \
+  template RowFault advanceParticleRowAvx2<S, PBD>(ParticleArrays<S>&, int64_t, int64_t, S, S, S,                 \
                                                    const ParticleConstants<S>&, std::vector<S>&, std::vector<S>&, \
                                                    std::vector<S>&);
 SG_INSTANTIATE_AVX2_ROW(Fx32, false)

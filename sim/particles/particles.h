@@ -15,10 +15,10 @@ namespace sg {
 /// detail off). Storage is toroidal (sim/lod/lattice_window.h); countX == window.sizeI and
 /// countZ == window.sizeJ always, so the pointwise stages simply run over countX * countZ.
 struct ParticleGrid {
-  int k = 1;            ///< patches per particle along each axis
-  int64_t countX = 0;   ///< particles per stored row (along x)
-  int64_t countZ = 0;   ///< stored particle rows (along z)
-  LatticeWindow window; ///< which particles of the field are held, and where
+  int k = 1;             ///< patches per particle along each axis
+  int64_t countX = 0;    ///< particles per stored row (along x)
+  int64_t countZ = 0;    ///< stored particle rows (along z)
+  LatticeWindow window;  ///< which particles of the field are held, and where
   int64_t size() const { return countX * countZ; }
   /// Particles per axis covering n patches: ceil((n - 1) / k) + 1.
   static int64_t coverCount(int64_t patches, int k) { return (patches - 1 + k - 1) / k + 1; }
@@ -26,8 +26,8 @@ struct ParticleGrid {
 
 template <class S>
 struct ParticleArrays {
-  std::vector<S> px, py, pz;              ///< position (m)
-  std::vector<S> vx, vy, vz;              ///< velocity (m/s)
+  std::vector<S> px, py, pz;                 ///< position (m)
+  std::vector<S> vx, vy, vz;                 ///< velocity (m/s)
   std::vector<S> anchorX, anchorY, anchorZ;  ///< rod anchor = tuft root on the ground (m)
   void resize(size_t n) {
     for (auto* v : {&px, &py, &pz, &vx, &vy, &vz, &anchorX, &anchorY, &anchorZ}) v->assign(n, S(0));

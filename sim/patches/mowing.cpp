@@ -19,9 +19,11 @@ void World<S>::mowGrass() {
       const Pose<S> pose = body.partPose(part);
       const S reach = shape.boundingRadius + lattice_.jitterAmplitude + lattice_.spacing;
       const int64_t i0 = std::max<int64_t>(0, floorToInt((pose.position.x() - reach - lattice_.originX) * invSpacing));
-      const int64_t i1 = std::min<int64_t>(lattice_.patchesX - 1, floorToInt((pose.position.x() + reach - lattice_.originX) * invSpacing) + 1);
+      const int64_t i1 = std::min<int64_t>(lattice_.patchesX - 1,
+                                           floorToInt((pose.position.x() + reach - lattice_.originX) * invSpacing) + 1);
       const int64_t j0 = std::max<int64_t>(0, floorToInt((pose.position.z() - reach - lattice_.originZ) * invSpacing));
-      const int64_t j1 = std::min<int64_t>(lattice_.patchesZ - 1, floorToInt((pose.position.z() + reach - lattice_.originZ) * invSpacing) + 1);
+      const int64_t j1 = std::min<int64_t>(lattice_.patchesZ - 1,
+                                           floorToInt((pose.position.z() + reach - lattice_.originZ) * invSpacing) + 1);
       // Roots come from the lattice, not the window: a mower cuts wherever it drives.
       for (int64_t j = j0; j <= j1; ++j)
         for (int64_t i = i0; i <= i1; ++i) {
@@ -47,9 +49,7 @@ void World<S>::mowGrass() {
   }
 }
 
-
-#define SG_INSTANTIATE_MOWING(S) \
-  template void World<S>::mowGrass(); \
+#define SG_INSTANTIATE_MOWING(S) template void World<S>::mowGrass();
 
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE_MOWING)
 

@@ -48,9 +48,9 @@ struct Lanes<Fx32> {
   }
   /// Lanes holding 0..3 as 4 bytes.
   SG_AVX2 static void storeBytes(uint8_t* out, __m256i v) {
-    const __m256i picked = _mm256_shuffle_epi8(
-        v, _mm256_setr_epi8(0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 8, -1, -1, -1, -1, -1, -1,
-                            -1, -1, -1, -1, -1, -1, -1, -1));
+    const __m256i picked =
+        _mm256_shuffle_epi8(v, _mm256_setr_epi8(0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 8, -1,
+                                                -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1));
     const int32_t lo = _mm_cvtsi128_si32(_mm256_castsi256_si128(picked));
     const int32_t hi = _mm_cvtsi128_si32(_mm256_extracti128_si256(picked, 1));
     const int32_t bytes = (lo & 0xFFFF) | (hi << 16);
@@ -120,16 +120,21 @@ SG_AVX2 __m256i threeQuarters(__m256i d) {
   const __m256i r = _mm256_and_si256(magnitude, L::all(3));
   const __m256i rounded = L::shiftRight(L::add(L::add(r, L::shiftLeft(r, 1)), L::all(2)), 2);
   const __m256i result = L::add(L::add(m, L::shiftLeft(m, 1)), rounded);
-  if constexpr (L::kBits == 64) return L::sub(_mm256_xor_si256(result, negative), negative);
-  else return _mm256_sign_epi32(result, d);  // d = 0 gives 0, which the product is
+  if constexpr (L::kBits == 64)
+    return L::sub(_mm256_xor_si256(result, negative), negative);
+  else
+    return _mm256_sign_epi32(result, d);  // d = 0 gives 0, which the product is
 }
 
 /// round((b - a) q / 4) for q = 1, 2, 3 quarters, as unchecked::lerpByFraction<S, 4> scales.
 template <class S, int Quarters>
 SG_AVX2 __m256i scaleByQuarters(__m256i d) {
-  if constexpr (Quarters == 1) return shiftRound<S, 2>(d);
-  else if constexpr (Quarters == 2) return shiftRound<S, 1>(d);
-  else return threeQuarters<S>(d);
+  if constexpr (Quarters == 1)
+    return shiftRound<S, 2>(d);
+  else if constexpr (Quarters == 2)
+    return shiftRound<S, 1>(d);
+  else
+    return threeQuarters<S>(d);
 }
 
 template <class S, int Quarters>
@@ -221,7 +226,8 @@ __attribute__((target("avx2"))) int64_t writePatches(const PatchWriter<S>& w, si
     store(w.tipOffsetZ + p, load(dz + q));
     const __m256i sink = L::sub(zero, load(dy + q));
     // smaller = sink < 0 ? 0 : min(sink, halfRod); top = scaleY - smaller - (cut ? reduction : 0)
-    const __m256i smaller = _mm256_andnot_si256(L::greater(zero, sink), select(L::greater(sink, halfRod), halfRod, sink));
+    const __m256i smaller =
+        _mm256_andnot_si256(L::greater(zero, sink), select(L::greater(sink, halfRod), halfRod, sink));
     const __m256i top = L::sub(L::sub(scaleY, smaller), _mm256_and_si256(L::cutMask(w.cut + p), cutReduction));
     store(w.topY + p, L::add(load(w.rootY + p), select(L::greater(minimumTop, top), minimumTop, top)));
     // tilt = [sink > drop0] + [sink > drop1] + [sink > drop2]: the scalar if-chain when the drops rise
@@ -235,9 +241,12 @@ __attribute__((target("avx2"))) int64_t writePatches(const PatchWriter<S>& w, si
 
 template <class S>
 void blendRowsAvx2(const S* a, const S* b, S* out, int64_t n, int quarters) {
-  if (quarters == 1) blendRows<S, 1>(a, b, out, n);
-  else if (quarters == 2) blendRows<S, 2>(a, b, out, n);
-  else blendRows<S, 3>(a, b, out, n);
+  if (quarters == 1)
+    blendRows<S, 1>(a, b, out, n);
+  else if (quarters == 2)
+    blendRows<S, 2>(a, b, out, n);
+  else
+    blendRows<S, 3>(a, b, out, n);
 }
 
 template <class S>

@@ -93,8 +93,8 @@ inline S lerpByFraction(S a, S b, int t) {
 /// fixed types compute it unchecked (the same bits): inside the fused particle pass
 /// (particle_row.h) it must not leave a fault bit for the next row's integration to misreport.
 template <class S>
-inline void particleDisplacement(const ParticleArrays<S>& p, int64_t begin, int64_t end, S rod,
-                                 std::vector<S>& dx, std::vector<S>& dy, std::vector<S>& dz) {
+inline void particleDisplacement(const ParticleArrays<S>& p, int64_t begin, int64_t end, S rod, std::vector<S>& dx,
+                                 std::vector<S>& dy, std::vector<S>& dz) {
   const S* px = p.px.data();
   const S* py = p.py.data();
   const S* pz = p.pz.data();
@@ -131,10 +131,19 @@ struct PatchWriter {
   S halfRod, scaleY, cutReduction, minimumTop, drop0, drop1, drop2;
 
   PatchWriter(PatchArrays<S>& patches, const PatchStateConstants<S>& c)
-      : tipOffsetX(patches.tipOffsetX.data()), tipOffsetZ(patches.tipOffsetZ.data()), topY(patches.topY.data()),
-        tiltLevel(patches.tiltLevel.data()), rootY(patches.rootY.data()), cut(patches.cut.data()),
-        halfRod(c.halfRod), scaleY(c.scaleY), cutReduction(c.cutReduction), minimumTop(c.minimumTop),
-        drop0(c.drop[0]), drop1(c.drop[1]), drop2(c.drop[2]) {}
+      : tipOffsetX(patches.tipOffsetX.data()),
+        tipOffsetZ(patches.tipOffsetZ.data()),
+        topY(patches.topY.data()),
+        tiltLevel(patches.tiltLevel.data()),
+        rootY(patches.rootY.data()),
+        cut(patches.cut.data()),
+        halfRod(c.halfRod),
+        scaleY(c.scaleY),
+        cutReduction(c.cutReduction),
+        minimumTop(c.minimumTop),
+        drop0(c.drop[0]),
+        drop1(c.drop[1]),
+        drop2(c.drop[2]) {}
 
   /// write() without the fault bookkeeping for the fixed types (the same bits: see `unchecked`).
   void writeFast(size_t p, S ddx, S ddy, S ddz) const {
@@ -220,19 +229,22 @@ inline bool rowWeightsAreExact(const PatchStateConstants<S>& c) {
 template <class S, int K = 0>
 inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWindow, int64_t j,
                            const LatticeWindow& particles, const std::vector<S>& dx, const std::vector<S>& dy,
-                           const std::vector<S>& dz, const PatchStateConstants<S>& c, S* scratch,
-                           bool vector = false) {
+                           const std::vector<S>& dz, const PatchStateConstants<S>& c, S* scratch, bool vector = false) {
   const int k = K != 0 ? K : c.k;
   const S* weight = c.weight.data();
   auto weightOf = [weight](int t) {
-    if constexpr (K != 0) return powerOfTwoWeight<S, K>(t);
-    else return weight[t];
+    if constexpr (K != 0)
+      return powerOfTwoWeight<S, K>(t);
+    else
+      return weight[t];
   };
   // K = 0 is the reference: Fixed's checked operators. K = 2, 4 compute the same bits unchecked.
   constexpr bool kFast = K != 0 && ScalarTraits<S>::isFixed;
   auto blend = [&weightOf](S a, S b, int t) {
-    if constexpr (kFast) return unchecked::lerpByFraction<S, K>(a, b, t);
-    else return lerp(a, b, weightOf(t));
+    if constexpr (kFast)
+      return unchecked::lerpByFraction<S, K>(a, b, t);
+    else
+      return lerp(a, b, weightOf(t));
   };
   const int64_t b0 = j / k, tz = j % k;
   const int64_t nx = particles.sizeI;
@@ -289,8 +301,10 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
       const int64_t steps = std::min({nx - 1 - sa, (rowSize - sp) / K, (endI - i) / K});
       if (vector && steps > 0) {
         for (auto [r, q] : {std::pair{rx, qx}, std::pair{ry, qy}, std::pair{rz, qz}}) {
-          if constexpr (K == 2) interpolateHalvesAvx2(r + sa, q + sp, steps);
-          else interpolateQuartersAvx2(r + sa, q + sp, steps);
+          if constexpr (K == 2)
+            interpolateHalvesAvx2(r + sa, q + sp, steps);
+          else
+            interpolateQuartersAvx2(r + sa, q + sp, steps);
         }
         sa += steps;
         sp += K * steps;
@@ -319,8 +333,10 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
   if constexpr (kFast)
     if (vector) return writePatchesAvx2(out, rowBase, qx, qy, qz, rowSize);
   for (int64_t q = 0; q < rowSize; ++q) {
-    if constexpr (kFast) out.writeFast(rowBase + size_t(q), qx[q], qy[q], qz[q]);
-    else out.write(rowBase + size_t(q), qx[q], qy[q], qz[q]);
+    if constexpr (kFast)
+      out.writeFast(rowBase + size_t(q), qx[q], qy[q], qz[q]);
+    else
+      out.write(rowBase + size_t(q), qx[q], qy[q], qz[q]);
   }
 }
 

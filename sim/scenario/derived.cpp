@@ -15,10 +15,10 @@ class Checked {
   }
   int64_t ticks(std::optional<Rational> r, const std::string& path) const {
     auto n = (*this)(r, path).roundToInt64();
-    if (!n || *n > (int64_t(1) << 40))
-      throw ScenarioError(s_.sourceName, path, "a duration below 2^40 ticks");
+    if (!n || *n > (int64_t(1) << 40)) throw ScenarioError(s_.sourceName, path, "a duration below 2^40 ticks");
     return *n;
   }
+
  private:
   const Scenario& s_;
 };
@@ -35,24 +35,28 @@ ScenarioConstants deriveConstants(const Scenario& s) {
   c.halfRod = ok(mul(p.constraintLength, Rational{1, 2}), "$.particles.constraintLength");
   c.invMass = ok(div(Rational{1, 1}, p.mass), "$.particles.mass");
   c.jitterAmplitude = ok(mul(f.jitter, f.spacing), "$.field.jitter");
-  c.fieldOriginX = ok(sub(f.centerX, ok(mul(f.spacing, Rational{f.patchesX - 1, 2}), "$.field.spacing")), "$.field.center[0]");
-  c.fieldOriginZ = ok(sub(f.centerZ, ok(mul(f.spacing, Rational{f.patchesZ - 1, 2}), "$.field.spacing")), "$.field.center[1]");
+  c.fieldOriginX =
+      ok(sub(f.centerX, ok(mul(f.spacing, Rational{f.patchesX - 1, 2}), "$.field.spacing")), "$.field.center[0]");
+  c.fieldOriginZ =
+      ok(sub(f.centerZ, ok(mul(f.spacing, Rational{f.patchesZ - 1, 2}), "$.field.spacing")), "$.field.center[1]");
   c.particlesX = (f.patchesX - 1 + k - 1) / k + 1;
   c.particlesZ = (f.patchesZ - 1 + k - 1) / k + 1;
   for (int t = 0; t < k; ++t) c.interpolationWeights.push_back(Rational{t, k});
-  c.invParticleSpacing = ok(div(Rational{1, 1}, ok(mul(f.spacing, Rational::integer(k)), "$.field.spacing")), "$.field.spacing");
+  c.invParticleSpacing =
+      ok(div(Rational{1, 1}, ok(mul(f.spacing, Rational::integer(k)), "$.field.spacing")), "$.field.spacing");
 
   for (size_t g = 0; g < s.wind.schedule.size(); ++g) {
     const std::string path = "$.wind.schedule[" + std::to_string(g) + "]";
     std::array<Rational, 3> perMass;
     for (int i = 0; i < 3; ++i)
-      perMass[size_t(i)] = ok(mul(s.wind.schedule[g].force[size_t(i)], c.invMass), path + ".force[" + std::to_string(i) + "]");
+      perMass[size_t(i)] =
+          ok(mul(s.wind.schedule[g].force[size_t(i)], c.invMass), path + ".force[" + std::to_string(i) + "]");
     c.gustForcePerMass.push_back(perMass);
     const Rational& duration = s.wind.schedule[g].duration;
     if (compare(duration, s.timeStep) < 0)
-      throw ScenarioError(s.sourceName, path + ".duration",
-                          "a duration of at least one time step (" + s.timeStep.toString() + " s), got " +
-                              duration.toString() + " s");
+      throw ScenarioError(
+          s.sourceName, path + ".duration",
+          "a duration of at least one time step (" + s.timeStep.toString() + " s), got " + duration.toString() + " s");
     c.gustTicks.push_back(ok.ticks(div(duration, s.timeStep), path + ".duration"));
   }
   // A gust front needs rowSpacing / (speed * dt) ticks per particle row.
@@ -68,8 +72,9 @@ ScenarioConstants deriveConstants(const Scenario& s) {
     c.terrainInvCellSize = ok(div(Rational{1, 1}, t.cellSize), "$.terrain.cellSize");
     c.terrainOriginX = ok(sub(t.centerX, ok(mul(t.cellSize, Rational{t.heightmap.width - 1, 2}), "$.terrain.cellSize")),
                           "$.terrain.center[0]");
-    c.terrainOriginZ = ok(sub(t.centerZ, ok(mul(t.cellSize, Rational{t.heightmap.height - 1, 2}), "$.terrain.cellSize")),
-                          "$.terrain.center[1]");
+    c.terrainOriginZ =
+        ok(sub(t.centerZ, ok(mul(t.cellSize, Rational{t.heightmap.height - 1, 2}), "$.terrain.cellSize")),
+           "$.terrain.center[1]");
     for (int v = 0; v < 256; ++v)
       c.terrainHeightOfSample[size_t(v)] = ok(mul(t.maxHeight, *Rational::make(v, 255)), "$.terrain.maxHeight");
   }

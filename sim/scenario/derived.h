@@ -13,21 +13,21 @@
 namespace sg {
 
 struct ScenarioConstants {
-  Rational invDt;            ///< 1/s
-  Rational dampingPerTick;   ///< damping^dt (deterministicPow)
-  Rational halfRod;          ///< L/2 (m)
-  Rational invMass;          ///< 1/kg
-  Rational jitterAmplitude;  ///< m
+  Rational invDt;                       ///< 1/s
+  Rational dampingPerTick;              ///< damping^dt (deterministicPow)
+  Rational halfRod;                     ///< L/2 (m)
+  Rational invMass;                     ///< 1/kg
+  Rational jitterAmplitude;             ///< m
   Rational fieldOriginX, fieldOriginZ;  ///< m, un-jittered position of patch (0, 0)
   int64_t particlesX = 0, particlesZ = 0;
-  Rational invParticleSpacing;  ///< 1 / (k spacing)
-  std::vector<Rational> interpolationWeights;  ///< t/k for t = 0..k-1
+  Rational invParticleSpacing;                            ///< 1 / (k spacing)
+  std::vector<Rational> interpolationWeights;             ///< t/k for t = 0..k-1
   std::vector<std::array<Rational, 3>> gustForcePerMass;  ///< N/kg
-  std::vector<int64_t> gustTicks;      ///< each gust's duration in ticks (>= 1)
-  std::vector<int64_t> rowDelayTicks;  ///< round(r * rowSpacing / (speed * dt)), r = 0..particlesZ-1
+  std::vector<int64_t> gustTicks;                         ///< each gust's duration in ticks (>= 1)
+  std::vector<int64_t> rowDelayTicks;                     ///< round(r * rowSpacing / (speed * dt)), r = 0..particlesZ-1
   // heightmap terrain only
   Rational terrainInvCellSize;
-  Rational terrainOriginX, terrainOriginZ;  ///< m, position of sample (0, 0)
+  Rational terrainOriginX, terrainOriginZ;            ///< m, position of sample (0, 0)
   std::array<Rational, 256> terrainHeightOfSample{};  ///< m, maxHeight * v / 255
 };
 

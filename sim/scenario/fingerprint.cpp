@@ -65,7 +65,8 @@ uint64_t scenarioFingerprint(const Scenario& s) {
         for (const Rational& r : part.halfExtents) putRational(h, r);
         for (const Rational& r : part.offset) putRational(h, r);
       }
-      for (const Rational* r : {&body.mass, &body.linearDamping, &body.angularDamping, &body.restitution, &body.friction})
+      for (const Rational* r :
+           {&body.mass, &body.linearDamping, &body.angularDamping, &body.restitution, &body.friction})
         putRational(h, *r);
       h.put(int64_t((body.mower ? 1 : 0) | (body.canSleep ? 2 : 0)));
     }

@@ -44,7 +44,7 @@ enum class BoxParticleNormal : uint8_t {
 
 struct ShapeSpec {
   ShapeType type = ShapeType::Sphere;
-  Rational radius{1, 2};                                      ///< m (sphere)
+  Rational radius{1, 2};                                                  ///< m (sphere)
   Rational3 halfExtents{Rational{1, 2}, Rational{1, 2}, Rational{1, 2}};  ///< m (box)
   Rational3 offset{Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};       ///< m, in the body frame
 };
@@ -57,12 +57,12 @@ struct BodySpec {
   std::array<Rational, 4> orientation{Rational{1, 1}, Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};  ///< w, x, y, z
   Rational3 velocity{Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
   Rational3 angularVelocity{Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
-  Rational linearDamping{1, 1};   ///< per-second velocity factor
+  Rational linearDamping{1, 1};  ///< per-second velocity factor
   Rational angularDamping{1, 1};
   Rational restitution{3, 10};
   Rational friction{1, 2};
-  bool mower = false;             ///< cuts the grass it touches
-  bool canSleep = true;           ///< may sleep when it has been still for a while (thesis: "ability to sleep")
+  bool mower = false;    ///< cuts the grass it touches
+  bool canSleep = true;  ///< may sleep when it has been still for a while (thesis: "ability to sleep")
   /// Optional OBJ file for the renderer's looks only (as written in the JSON, relative to the
   /// scenario file's directory); never affects the simulation or the state hash.
   std::string mesh;
@@ -111,21 +111,21 @@ struct Scenario {
 
   struct Field {
     int64_t patchesX = 151, patchesZ = 151;
-    Rational spacing{1, 4};      ///< m between patch centres
-    Rational jitter{3, 10};      ///< max |offset| as a fraction of spacing
+    Rational spacing{1, 4};                 ///< m between patch centres
+    Rational jitter{3, 10};                 ///< max |offset| as a fraction of spacing
     Rational centerX{0, 1}, centerZ{0, 1};  ///< m, world position of the field centre
-    Rational scaleY{1, 1};       ///< m, tuft quad height (mScaleY)
-    Rational scaleXZ{1, 2};      ///< m, tuft quad half width (mScaleXZ)
+    Rational scaleY{1, 1};                  ///< m, tuft quad height (mScaleY)
+    Rational scaleXZ{1, 2};                 ///< m, tuft quad half width (mScaleXZ)
     int atlasVariants = 4;
   } field;
 
   struct Particles {
-    int interpolation = 1;           ///< k: one particle per k x k patches
-    Rational constraintLength{1, 1}; ///< m, rod length L
+    int interpolation = 1;                                                      ///< k: one particle per k x k patches
+    Rational constraintLength{1, 1};                                            ///< m, rod length L
     Rational3 initialVelocity{Rational{1, 5}, Rational{1, 5}, Rational{1, 5}};  ///< m/s
     Rational3 acceleration{Rational{0, 1}, Rational{1, 1}, Rational{0, 1}};     ///< m/s^2
-    Rational mass{1, 1};             ///< kg
-    Rational damping{97, 100};       ///< velocity factor per second (v *= damping^dt)
+    Rational mass{1, 1};                                                        ///< kg
+    Rational damping{97, 100};  ///< velocity factor per second (v *= damping^dt)
     ConstraintMode constraintMode = ConstraintMode::Thesis;
     /// Tilt brightness thresholds: level n when the tip sinks more than tiltDrop[n-1] below L.
     std::array<Rational, 3> tiltDrop{Rational{1, 5}, Rational{3, 10}, Rational{2, 5}};
@@ -147,15 +147,15 @@ struct Scenario {
     Rational flatHeight{0, 1};  ///< m
     std::string heightmapPath;  ///< as written in the scenario (relative to the scenario file)
     Heightmap heightmap;
-    Rational cellSize{1, 1};    ///< m between heightmap samples
-    Rational maxHeight{5, 1};   ///< m at sample value 255
+    Rational cellSize{1, 1};                ///< m between heightmap samples
+    Rational maxHeight{5, 1};               ///< m at sample value 255
     Rational centerX{0, 1}, centerZ{0, 1};  ///< m, world position of the heightmap centre
   } terrain;
 
   struct Bodies {
     Rational3 gravity{Rational{0, 1}, Rational{-981, 100}, Rational{0, 1}};  ///< m/s^2
     int velocityIterations = 16;  // 8 lets a 5-box stack walk and fall (tests/body_accuracy_test.cpp)
-    int positionIterations = 8;  ///< per contact (Cyclone: twice the contact count)
+    int positionIterations = 8;   ///< per contact (Cyclone: twice the contact count)
     ParticleBroadphase particleBroadphase = ParticleBroadphase::Grid;
     BodyBroadphase bodyBroadphase = BodyBroadphase::Brute;
     BoxParticleNormal boxParticleNormal = BoxParticleNormal::Up;
@@ -174,7 +174,7 @@ struct Scenario {
     Rational length{30, 1}, width{20, 1}, lineWidth{1, 2}, centerCircleRadius{3, 1};
   } markings;
   std::vector<ScriptedCommand> script;  ///< sorted by tick, then body
-  std::vector<CameraKey> camera;         ///< scripted camera track, increasing ticks
+  std::vector<CameraKey> camera;        ///< scripted camera track, increasing ticks
 
   /// Level of detail. Off: the whole field is simulated. Window: W x H particles around the
   /// camera (level 0), a static edge-grass ring of `edgeRows` rows at `edgeSpacing` x the grass
@@ -198,6 +198,7 @@ class ScenarioError : public std::runtime_error {
   ScenarioError(const std::string& file, const std::string& path, const std::string& expected);
   const std::string& file() const { return file_; }
   const std::string& path() const { return path_; }
+
  private:
   std::string file_, path_;
 };
@@ -209,15 +210,14 @@ using ScenarioFileReader =
 
 /// Parses and validates a scenario. Throws ScenarioError. Unknown keys are errors; missing keys
 /// take the thesis defaults above.
-Scenario parseScenario(const std::string& text, const std::string& sourceName,
-                       const ScenarioFileReader& readFile);
+Scenario parseScenario(const std::string& text, const std::string& sourceName, const ScenarioFileReader& readFile);
 
 /// An input-track file (docs/scenario-format.md): camera keys and body commands that replace a
 /// scenario's script when recording. Commands name bodies of `scenario` and use the script's
 /// schema; the camera holds each key's position until the next key.
 struct InputTrack {
-  std::optional<int64_t> ticks;        ///< how long to record, when the track says
-  std::vector<CameraKey> camera;       ///< increasing ticks
+  std::optional<int64_t> ticks;           ///< how long to record, when the track says
+  std::vector<CameraKey> camera;          ///< increasing ticks
   std::vector<ScriptedCommand> commands;  ///< sorted by tick
 };
 /// Throws ScenarioError (file, JSON path, expected) like parseScenario.

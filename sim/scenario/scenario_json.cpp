@@ -2,10 +2,10 @@
 // was expected. Numbers are read from their raw text (collected by a SAX pass) so that the
 // decimal -> fixed-point conversion is exact.
 #include <algorithm>
+#include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <cstdio>
 #include <sstream>
 
 #include "sim/scenario/scenario.h"
@@ -97,15 +97,22 @@ class RawNumberCollector : public nlohmann::json_sax<json> {
 
 const char* typeName(const json& j) {
   switch (j.type()) {
-    case json::value_t::null: return "null";
-    case json::value_t::boolean: return "a boolean";
-    case json::value_t::string: return "a string";
-    case json::value_t::array: return "an array";
-    case json::value_t::object: return "an object";
+    case json::value_t::null:
+      return "null";
+    case json::value_t::boolean:
+      return "a boolean";
+    case json::value_t::string:
+      return "a string";
+    case json::value_t::array:
+      return "an array";
+    case json::value_t::object:
+      return "an object";
     case json::value_t::number_integer:
     case json::value_t::number_unsigned:
-    case json::value_t::number_float: return "a number";
-    default: return "a value";
+    case json::value_t::number_float:
+      return "a number";
+    default:
+      return "a value";
   }
 }
 
@@ -222,7 +229,8 @@ void parseField(const Reader& r, const json& j, Scenario::Field& f) {
   if (j.contains("spacing")) f.spacing = r.positive(j["spacing"], p + ".spacing");
   if (j.contains("jitter")) {
     f.jitter = r.nonNegative(j["jitter"], p + ".jitter");
-    if (compare(f.jitter, Rational{1, 2}) > 0) r.failGot(p + ".jitter", "a fraction of the spacing from 0 to 0.5", j["jitter"]);
+    if (compare(f.jitter, Rational{1, 2}) > 0)
+      r.failGot(p + ".jitter", "a fraction of the spacing from 0 to 0.5", j["jitter"]);
   }
   r.center(j, p, &f.centerX, &f.centerZ);
   if (j.contains("scaleY")) f.scaleY = r.positive(j["scaleY"], p + ".scaleY");
@@ -232,8 +240,9 @@ void parseField(const Reader& r, const json& j, Scenario::Field& f) {
 
 void parseParticles(const Reader& r, const json& j, Scenario::Particles& s) {
   const std::string p = "$.particles";
-  r.object(j, p, {"interpolation", "constraintLength", "initialVelocity", "acceleration", "mass", "damping",
-                  "constraintMode", "tiltDrop"});
+  r.object(j, p,
+           {"interpolation", "constraintLength", "initialVelocity", "acceleration", "mass", "damping", "constraintMode",
+            "tiltDrop"});
   if (j.contains("interpolation")) s.interpolation = int(r.integer(j["interpolation"], p + ".interpolation", 1, 4));
   if (j.contains("constraintLength")) s.constraintLength = r.positive(j["constraintLength"], p + ".constraintLength");
   if (j.contains("initialVelocity")) s.initialVelocity = r.vector<3>(j["initialVelocity"], p + ".initialVelocity");
@@ -281,12 +290,13 @@ void parseWind(const Reader& r, const json& j, Scenario::Wind& w) {
 void parseTerrain(const Reader& r, const json& j, Scenario::Terrain& t, const ScenarioFileReader& readFile) {
   const std::string p = "$.terrain";
   r.object(j, p, {"type", "height", "file", "cellSize", "maxHeight", "center"});
-  const bool heightmap = j.contains("type") &&
-      r.choice<bool>(j["type"], p + ".type", {{"flat", false}, {"heightmap", true}});
+  const bool heightmap =
+      j.contains("type") && r.choice<bool>(j["type"], p + ".type", {{"flat", false}, {"heightmap", true}});
   t.flat = !heightmap;
   if (!heightmap) {
     for (const char* k : {"file", "cellSize", "maxHeight", "center"})
-      if (j.contains(k)) r.fail(p + "." + k, "no '" + std::string(k) + "' for a flat terrain (set \"type\": \"heightmap\")");
+      if (j.contains(k))
+        r.fail(p + "." + k, "no '" + std::string(k) + "' for a flat terrain (set \"type\": \"heightmap\")");
     if (j.contains("height")) t.flatHeight = r.number(j["height"], p + ".height");
     return;
   }
@@ -299,8 +309,7 @@ void parseTerrain(const Reader& r, const json& j, Scenario::Terrain& t, const Sc
   std::vector<uint8_t> bytes;
   std::string why;
   if (!readFile || !readFile(t.heightmapPath, &bytes, &why)) r.fail(p + ".file", why.empty() ? "a readable file" : why);
-  if (!decodeHeightmapPng(bytes, &t.heightmap, &why))
-    r.fail(p + ".file", "'" + t.heightmapPath + "' to be " + why);
+  if (!decodeHeightmapPng(bytes, &t.heightmap, &why)) r.fail(p + ".file", "'" + t.heightmapPath + "' to be " + why);
 }
 
 ShapeSpec parseShapePart(const Reader& r, const json& j, const std::string& p, bool allowOffset) {
@@ -326,11 +335,13 @@ ShapeSpec parseShapePart(const Reader& r, const json& j, const std::string& p, b
 
 BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
   BodySpec b;
-  r.object(j, p, {"name", "shape", "mass", "position", "orientation", "velocity", "angularVelocity", "linearDamping",
-                  "angularDamping", "restitution", "friction", "mower", "canSleep", "mesh"});
+  r.object(j, p,
+           {"name", "shape", "mass", "position", "orientation", "velocity", "angularVelocity", "linearDamping",
+            "angularDamping", "restitution", "friction", "mower", "canSleep", "mesh"});
   if (!j.contains("name")) r.fail(p + ".name", "a body name (missing)");
   b.name = r.string(j["name"], p + ".name");
-  if (!j.contains("shape")) r.fail(p + ".shape", "a shape {\"type\": \"sphere\" | \"box\" | \"compound\", ...} (missing)");
+  if (!j.contains("shape"))
+    r.fail(p + ".shape", "a shape {\"type\": \"sphere\" | \"box\" | \"compound\", ...} (missing)");
   const json& sh = j["shape"];
   const std::string sp = p + ".shape";
   r.object(sh, sp, {"type", "radius", "halfExtents", "parts"});
@@ -362,7 +373,8 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
   factor("angularDamping", b.angularDamping);
   if (j.contains("restitution")) {
     b.restitution = r.nonNegative(j["restitution"], p + ".restitution");
-    if (compare(b.restitution, Rational{1, 1}) > 0) r.failGot(p + ".restitution", "a restitution in [0, 1]", j["restitution"]);
+    if (compare(b.restitution, Rational{1, 1}) > 0)
+      r.failGot(p + ".restitution", "a restitution in [0, 1]", j["restitution"]);
   }
   if (j.contains("friction")) b.friction = r.nonNegative(j["friction"], p + ".friction");
   if (j.contains("mower")) {
@@ -380,8 +392,9 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
 
 void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
   const std::string p = "$.bodies";
-  r.object(j, p, {"gravity", "velocityIterations", "positionIterations", "particleBroadphase", "bodyBroadphase",
-                  "boxParticleNormal", "mowerCutHeight", "grassDrag", "list"});
+  r.object(j, p,
+           {"gravity", "velocityIterations", "positionIterations", "particleBroadphase", "bodyBroadphase",
+            "boxParticleNormal", "mowerCutHeight", "grassDrag", "list"});
   if (j.contains("grassDrag")) b.grassDrag = r.nonNegative(j["grassDrag"], p + ".grassDrag");
   if (j.contains("mowerCutHeight")) b.mowerCutHeight = r.nonNegative(j["mowerCutHeight"], p + ".mowerCutHeight");
   if (j.contains("gravity")) b.gravity = r.vector<3>(j["gravity"], p + ".gravity");
@@ -390,14 +403,17 @@ void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
   if (j.contains("positionIterations"))
     b.positionIterations = int(r.integer(j["positionIterations"], p + ".positionIterations", 0, 1000));
   if (j.contains("particleBroadphase"))
-    b.particleBroadphase = r.choice<ParticleBroadphase>(j["particleBroadphase"], p + ".particleBroadphase",
-                                                        {{"grid", ParticleBroadphase::Grid}, {"brute", ParticleBroadphase::Brute}});
+    b.particleBroadphase =
+        r.choice<ParticleBroadphase>(j["particleBroadphase"], p + ".particleBroadphase",
+                                     {{"grid", ParticleBroadphase::Grid}, {"brute", ParticleBroadphase::Brute}});
   if (j.contains("bodyBroadphase"))
-    b.bodyBroadphase = r.choice<BodyBroadphase>(j["bodyBroadphase"], p + ".bodyBroadphase",
-                                                {{"brute", BodyBroadphase::Brute}, {"sap", BodyBroadphase::SweepAndPrune}});
+    b.bodyBroadphase =
+        r.choice<BodyBroadphase>(j["bodyBroadphase"], p + ".bodyBroadphase",
+                                 {{"brute", BodyBroadphase::Brute}, {"sap", BodyBroadphase::SweepAndPrune}});
   if (j.contains("boxParticleNormal"))
-    b.boxParticleNormal = r.choice<BoxParticleNormal>(j["boxParticleNormal"], p + ".boxParticleNormal",
-                                                      {{"up", BoxParticleNormal::Up}, {"nearest-face", BoxParticleNormal::NearestFace}});
+    b.boxParticleNormal =
+        r.choice<BoxParticleNormal>(j["boxParticleNormal"], p + ".boxParticleNormal",
+                                    {{"up", BoxParticleNormal::Up}, {"nearest-face", BoxParticleNormal::NearestFace}});
   if (j.contains("list")) {
     const json& l = j["list"];
     if (!l.is_array() || l.size() > 1024) r.failGot(p + ".list", "an array of at most 1024 bodies", l);
@@ -405,7 +421,8 @@ void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
       const std::string q = p + ".list[" + std::to_string(i) + "]";
       b.list.push_back(parseBody(r, l[i], q));
       for (size_t k = 0; k + 1 < b.list.size(); ++k)
-        if (b.list[k].name == b.list.back().name) r.fail(q + ".name", "a unique body name, '" + b.list.back().name + "' is taken");
+        if (b.list[k].name == b.list.back().name)
+          r.fail(q + ".name", "a unique body name, '" + b.list.back().name + "' is taken");
     }
   }
 }
@@ -418,7 +435,8 @@ void parseMarkings(const Reader& r, const json& j, Scenario::Markings& m) {
   if (j.contains("length")) m.length = r.positive(j["length"], p + ".length");
   if (j.contains("width")) m.width = r.positive(j["width"], p + ".width");
   if (j.contains("lineWidth")) m.lineWidth = r.positive(j["lineWidth"], p + ".lineWidth");
-  if (j.contains("centerCircleRadius")) m.centerCircleRadius = r.nonNegative(j["centerCircleRadius"], p + ".centerCircleRadius");
+  if (j.contains("centerCircleRadius"))
+    m.centerCircleRadius = r.nonNegative(j["centerCircleRadius"], p + ".centerCircleRadius");
 }
 
 void parseCamera(const Reader& r, const json& cams, const std::string& p, std::vector<CameraKey>& out) {
@@ -431,7 +449,8 @@ void parseCamera(const Reader& r, const json& cams, const std::string& p, std::v
     CameraKey key;
     key.tick = r.integer(cams[i]["tick"], q + ".tick", 0, int64_t(1) << 40);
     if (!out.empty() && key.tick <= out.back().tick)
-      r.failGot(q + ".tick", "a tick after the previous camera key's " + std::to_string(out.back().tick), cams[i]["tick"]);
+      r.failGot(q + ".tick", "a tick after the previous camera key's " + std::to_string(out.back().tick),
+                cams[i]["tick"]);
     key.position = r.vector<3>(cams[i]["position"], q + ".position");
     out.push_back(key);
   }
@@ -440,7 +459,8 @@ void parseCamera(const Reader& r, const json& cams, const std::string& p, std::v
 void parseLod(const Reader& r, const json& j, Scenario::Lod& l) {
   const std::string p = "$.lod";
   r.object(j, p, {"mode", "window", "center", "edgeSpacing", "edgeRows"});
-  if (j.contains("mode")) l.mode = r.choice<LodMode>(j["mode"], p + ".mode", {{"off", LodMode::Off}, {"window", LodMode::Window}});
+  if (j.contains("mode"))
+    l.mode = r.choice<LodMode>(j["mode"], p + ".mode", {{"off", LodMode::Off}, {"window", LodMode::Window}});
   if (j.contains("window")) {
     const json& w = j["window"];
     if (!w.is_array() || w.size() != 2) r.failGot(p + ".window", "[particles along x, particles along z]", w);
@@ -479,10 +499,14 @@ void parseScript(const Reader& r, const json& j, const Scenario& s, const std::s
     cmd.body = scriptBody(r, c["body"], s, q + ".body");
     if (!c.contains("command")) r.fail(q + ".command", "a command (missing)");
     cmd.kind = r.choice<BodyCommandKind>(c["command"], q + ".command",
-                                         {{"displace", BodyCommandKind::Displace}, {"addVelocity", BodyCommandKind::AddVelocity},
-                                          {"impulse", BodyCommandKind::Impulse}, {"teleport", BodyCommandKind::Teleport},
-                                          {"reset", BodyCommandKind::Reset}, {"spawn", BodyCommandKind::Spawn},
-                                          {"mowerOn", BodyCommandKind::MowerOn}, {"mowerOff", BodyCommandKind::MowerOff}});
+                                         {{"displace", BodyCommandKind::Displace},
+                                          {"addVelocity", BodyCommandKind::AddVelocity},
+                                          {"impulse", BodyCommandKind::Impulse},
+                                          {"teleport", BodyCommandKind::Teleport},
+                                          {"reset", BodyCommandKind::Reset},
+                                          {"spawn", BodyCommandKind::Spawn},
+                                          {"mowerOn", BodyCommandKind::MowerOn},
+                                          {"mowerOff", BodyCommandKind::MowerOff}});
     // reset and the blade switches take no value; every other command needs one.
     const bool needsValue = cmd.kind != BodyCommandKind::Reset && cmd.kind != BodyCommandKind::MowerOn &&
                             cmd.kind != BodyCommandKind::MowerOff;
@@ -492,9 +516,8 @@ void parseScript(const Reader& r, const json& j, const Scenario& s, const std::s
       r.fail(q + ".value", "a vector [x, y, z] (missing)");
     script.push_back(cmd);
   }
-  std::stable_sort(script.begin(), script.end(), [](const ScriptedCommand& a, const ScriptedCommand& b) {
-    return a.tick < b.tick;
-  });
+  std::stable_sort(script.begin(), script.end(),
+                   [](const ScriptedCommand& a, const ScriptedCommand& b) { return a.tick < b.tick; });
 }
 
 std::string lineColumn(const std::string& text, size_t byte) {
@@ -516,9 +539,12 @@ namespace {
 std::string oneLine(const std::string& s) {
   std::string out;
   for (unsigned char c : s) {
-    if (c == '\n') out += "\\n";
-    else if (c == '\r') out += "\\r";
-    else if (c == '\t') out += "\\t";
+    if (c == '\n')
+      out += "\\n";
+    else if (c == '\r')
+      out += "\\r";
+    else if (c == '\t')
+      out += "\\t";
     else if (c < 0x20 || c == 0x7f) {
       char buf[8];
       std::snprintf(buf, sizeof buf, "\\x%02x", c);
@@ -571,8 +597,9 @@ Scenario parseScenario(const std::string& text, const std::string& sourceName, c
   Scenario s;
   s.sourceName = sourceName;
   s.text = text;
-  r.object(root, "$", {"format", "name", "description", "seed", "scalar", "timeStep", "field", "particles", "wind", "terrain",
-                       "bodies", "script", "markings", "camera", "lod"});
+  r.object(root, "$",
+           {"format", "name", "description", "seed", "scalar", "timeStep", "field", "particles", "wind", "terrain",
+            "bodies", "script", "markings", "camera", "lod"});
   if (root.contains("format") && root["format"] != "simgrass-scenario/1")
     r.failGot("$.format", "\"simgrass-scenario/1\"", root["format"]);
   if (root.contains("name")) s.name = r.string(root["name"], "$.name");

@@ -1,6 +1,6 @@
 // Scalar-specific checks: does this scenario fit the chosen number format and the memory?
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "sim/bodies/rigid_body.h"
@@ -23,9 +23,9 @@ void checkResolution(const Scenario& s) {
   auto nonZero = [&](const Rational& r, const char* path, const char* what) {
     auto v = T::fromRational(r);
     if (!v || *v == S(0))
-      throw ScenarioError(s.sourceName, path,
-                          std::string(what) + " that does not round to zero in " + scalarName(T::kind) + ", got " +
-                              r.toString());
+      throw ScenarioError(
+          s.sourceName, path,
+          std::string(what) + " that does not round to zero in " + scalarName(T::kind) + ", got " + r.toString());
   };
   nonZero(s.timeStep, "$.timeStep", "a time step");
   nonZero(s.field.spacing, "$.field.spacing", "a spacing");
@@ -50,8 +50,8 @@ uint64_t estimateWorldBytes(const Scenario& s, ScalarKind scalar) {
     const uint64_t m = uint64_t(s.lod.edgeSpacing), r = uint64_t(s.lod.edgeRows);
     ring = (nx / m + 2 + 2 * r) * (nz / m + 2 + 2 * r) * (3 * sz + 4);
   }
-  const uint64_t perPatch = 3 * sz + 3 + 3 * sz + 1;      // root, rotation+variant, derived
-  const uint64_t perParticle = 9 * sz + 3 * sz;            // p, v, anchor, displacement
+  const uint64_t perPatch = 3 * sz + 3 + 3 * sz + 1;  // root, rotation+variant, derived
+  const uint64_t perParticle = 9 * sz + 3 * sz;       // p, v, anchor, displacement
   return nx * nz * perPatch + px * pz * perParticle + ring;
 }
 
@@ -101,8 +101,8 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
       if (!ScalarTraits<S>::fromRational(r) || !(std::fabs(r.toDouble()) <= limit))
         throw ScenarioError(s.sourceName, path,
                             "a value within the " + std::string(scalarName(ScalarTraits<S>::kind)) +
-                                " range (|value| <= " + metres(limit).substr(0, metres(limit).size() - 2) +
-                                "), got " + r.toString());
+                                " range (|value| <= " + metres(limit).substr(0, metres(limit).size() - 2) + "), got " +
+                                r.toString());
     };
     const auto& pa = s.particles;
     for (int c = 0; c < 3; ++c) {

@@ -67,7 +67,8 @@ class Cursor {
 class StateReader {
  public:
   explicit StateReader(std::span<const uint8_t> bytes) : bytes_(bytes) {
-    if (bytes.size() < sizeof kMagic) throw StateError(bytes.size(), "the 8-byte state magic 'SGSTATE2' (the data ends early)");
+    if (bytes.size() < sizeof kMagic)
+      throw StateError(bytes.size(), "the 8-byte state magic 'SGSTATE2' (the data ends early)");
     if (std::memcmp(bytes.data(), "SGSTATE", 7) == 0 && bytes[7] != uint8_t(kMagic[7]))
       throw StateError(7, std::string("state format version 2 ('SGSTATE2'), got a version '") + char(bytes[7]) +
                               "' state (made by another release: re-record it)");
@@ -86,7 +87,8 @@ class StateReader {
     const uint64_t start = at_ + kSectionHeaderBytes;
     if (length > bytes_.size() - start)
       throw StateError(at_ + 4, std::string("a length for section '") + tag + "' within the data (" +
-                                    std::to_string(bytes_.size() - start) + " bytes left), got " + std::to_string(length));
+                                    std::to_string(bytes_.size() - start) + " bytes left), got " +
+                                    std::to_string(length));
     if (payloadBytes >= 0 && length != uint64_t(payloadBytes))
       throw StateError(at_ + 4, std::string("section '") + tag + "' of " + std::to_string(payloadBytes) +
                                     " bytes, got " + std::to_string(length));

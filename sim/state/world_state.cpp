@@ -43,9 +43,10 @@ void World<S>::serialise(StateSink& sink) const {
 
   putSection(sink, Section::Bodies, bodies_.size() * (13 * sizeof(S) + kBodyExtraBytes));
   for (const RigidBody<S>& b : bodies_) {
-    const S values[13] = {b.position.x(), b.position.y(), b.position.z(), b.orientation.w(), b.orientation.x(),
-                          b.orientation.y(), b.orientation.z(), b.velocity.x(), b.velocity.y(), b.velocity.z(),
-                          b.angularVelocity.x(), b.angularVelocity.y(), b.angularVelocity.z()};
+    const S values[13] = {b.position.x(),       b.position.y(),    b.position.z(),        b.orientation.w(),
+                          b.orientation.x(),    b.orientation.y(), b.orientation.z(),     b.velocity.x(),
+                          b.velocity.y(),       b.velocity.z(),    b.angularVelocity.x(), b.angularVelocity.y(),
+                          b.angularVelocity.z()};
     sink.putArray(values, 13);
     sink.put(b.stillTicks);
     sink.put(uint8_t((b.asleep ? kBodyAsleep : 0) | (b.mower && !b.bladeOn ? kBodyBladeOff : 0)));
@@ -116,7 +117,8 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
 
   Cursor head = reader.next(Section::Head, kHeadBytes);
   head.expect<uint32_t>(kVersion, "state format version 2");
-  head.expect<uint8_t>(uint8_t(ScalarTraits<S>::kind), std::string("a state of scalar ") + scalarName(ScalarTraits<S>::kind));
+  head.expect<uint8_t>(uint8_t(ScalarTraits<S>::kind),
+                       std::string("a state of scalar ") + scalarName(ScalarTraits<S>::kind));
   head.expect<uint8_t>(uint8_t(grid_.k), "interpolation k = " + std::to_string(grid_.k));
   head.expect<uint16_t>(0, "reserved 0");
   head.expect<uint64_t>(configHash_, "a state saved from the same scenario (fingerprint differs)");
@@ -129,10 +131,10 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   // Spawns add bodies up to kMaxBodies (only to worlds that have a template body).
   const size_t maxBodies = scenarioBodies == 0 ? 0 : std::max(scenarioBodies, size_t(kMaxBodies));
   if (bodyCount < scenarioBodies || bodyCount > maxBodies)
-    throw StateError(bodiesAt, (maxBodies == scenarioBodies ? std::to_string(scenarioBodies)
-                                                            : std::to_string(scenarioBodies) + " to " +
-                                                                  std::to_string(maxBodies)) +
-                                   " bodies, got " + std::to_string(bodyCount));
+    throw StateError(
+        bodiesAt, (maxBodies == scenarioBodies ? std::to_string(scenarioBodies)
+                                               : std::to_string(scenarioBodies) + " to " + std::to_string(maxBodies)) +
+                      " bodies, got " + std::to_string(bodyCount));
   head.expect<uint32_t>(0, "reserved 0");
 
   Cursor particles = reader.next(Section::Particles, int64_t(6 * n * sizeof(S)));  // read last
@@ -161,8 +163,9 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   const uint64_t spawnCountAt = spawnSection.offset();
   const uint32_t spawnCount = spawnSection.read<uint32_t>("the spawn count");
   if (spawnCount != bodyCount - scenarioBodies)
-    throw StateError(spawnCountAt, std::to_string(bodyCount - scenarioBodies) + " spawned bodies (the body count less " +
-                                       std::to_string(scenarioBodies) + " scenario bodies), got " + std::to_string(spawnCount));
+    throw StateError(spawnCountAt, std::to_string(bodyCount - scenarioBodies) +
+                                       " spawned bodies (the body count less " + std::to_string(scenarioBodies) +
+                                       " scenario bodies), got " + std::to_string(spawnCount));
   spawnSection.need(uint64_t(spawnCount) * kSpawnBytes, "the spawned bodies");
   std::vector<Spawned> spawns;
   for (uint32_t i = 0; i < spawnCount; ++i) {
@@ -182,7 +185,8 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
     if (!(records[b].flags & kBodyBladeOff)) continue;
     const size_t t = b < scenarioBodies ? b : size_t(spawns[b - scenarioBodies].templateBody);
     if (!initialBodies_[t].mower)
-      throw StateError(records[b].at + 13 * sizeof(S) + 4, "no blade-off flag: body " + std::to_string(b) + " is no mower");
+      throw StateError(records[b].at + 13 * sizeof(S) + 4,
+                       "no blade-off flag: body " + std::to_string(b) + " is no mower");
   }
 
   Cursor impulseSection = reader.next(Section::Impulses);
@@ -219,7 +223,8 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
     const uint64_t at = cutSection.offset();
     const int64_t i = cutSection.read<int64_t>("a patch column");
     const int64_t j = cutSection.read<int64_t>("a patch row");
-    if (i < 0 || j < 0 || i >= lattice_.patchesX || j >= lattice_.patchesZ) throw StateError(at, "a patch inside the field");
+    if (i < 0 || j < 0 || i >= lattice_.patchesX || j >= lattice_.patchesZ)
+      throw StateError(at, "a patch inside the field");
     if (!cuts.empty() && !(cuts.rbegin()->first < std::make_pair(i, j)))
       throw StateError(at, "mown patches in increasing (i, j) order");
     cuts.emplace_hint(cuts.end(), std::make_pair(i, j), uint8_t(1));
@@ -228,11 +233,13 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   Cursor windowSection = reader.next(Section::Window, 16);
   const int64_t originI = windowSection.read<int64_t>("the window origin");
   const int64_t originJ = windowSection.read<int64_t>("the window origin");
-  const bool originValid = lodWindow_ ? originI == clampWindowOrigin(originI, true) && originJ == clampWindowOrigin(originJ, false)
-                                      : originI == 0 && originJ == 0;
+  const bool originValid =
+      lodWindow_ ? originI == clampWindowOrigin(originI, true) && originJ == clampWindowOrigin(originJ, false)
+                 : originI == 0 && originJ == 0;
   if (!originValid)
-    throw StateError(windowSection.offset() - 16, lodWindow_ ? "a window origin that keeps the window inside the field"
-                                                             : "window origin (0, 0) (this world has no level-of-detail window)");
+    throw StateError(windowSection.offset() - 16,
+                     lodWindow_ ? "a window origin that keeps the window inside the field"
+                                : "window origin (0, 0) (this world has no level-of-detail window)");
   reader.expectEnd();
 
   // Everything checked: apply. Static window data first (anchors, patches, cut flags from the
@@ -322,11 +329,11 @@ void World<S>::exportState(StateExport& out) const {
   for (const auto& [key, value] : cuts_) out.cuts.push_back({key.first, key.second});
 }
 
-#define SG_INSTANTIATE_STATE_IO(S)                                         \
-  template void World<S>::serialise(StateSink&) const;                     \
-  template uint64_t World<S>::stateHash() const;                           \
-  template std::vector<uint8_t> World<S>::saveState() const;               \
-  template void World<S>::restoreState(std::span<const uint8_t>);          \
+#define SG_INSTANTIATE_STATE_IO(S)                                \
+  template void World<S>::serialise(StateSink&) const;            \
+  template uint64_t World<S>::stateHash() const;                  \
+  template std::vector<uint8_t> World<S>::saveState() const;      \
+  template void World<S>::restoreState(std::span<const uint8_t>); \
   template void World<S>::exportState(StateExport&) const;
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE_STATE_IO)
 

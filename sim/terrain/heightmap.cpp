@@ -38,8 +38,7 @@ bool decodeHeightmapPng(std::span<const uint8_t> bytes, Heightmap* out, std::str
     return false;
   }
   if (w < 2 || h < 2 || w > 16384 || h > 16384) {
-    *error = "a heightmap between 2x2 and 16384x16384 samples, got " + std::to_string(w) + "x" +
-             std::to_string(h);
+    *error = "a heightmap between 2x2 and 16384x16384 samples, got " + std::to_string(w) + "x" + std::to_string(h);
     return false;
   }
   stbi_uc* pixels = stbi_load_from_memory(data, len, &w, &h, &channels, 1);

@@ -10,8 +10,8 @@
 namespace sg {
 
 struct Heightmap {
-  int width = 0;   ///< samples along x
-  int height = 0;  ///< samples along z
+  int width = 0;                 ///< samples along x
+  int height = 0;                ///< samples along z
   std::vector<uint8_t> samples;  ///< row-major, z rows of x samples
 };
 

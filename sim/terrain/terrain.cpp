@@ -32,10 +32,22 @@ typename Terrain<S>::Cell Terrain<S>::cellAt(S x, S z) const {
   const S fz = (z - originZ_) * invCellSize_;
   Cell c{floorToInt(fx), floorToInt(fz), fractionalPart(fx), fractionalPart(fz)};
   // Clamp outside the map: the edge sample extends (t = 0 at the low edge, t = 1 at the high).
-  if (c.ix < 0) { c.ix = 0; c.tx = S(0); }
-  if (c.iz < 0) { c.iz = 0; c.tz = S(0); }
-  if (c.ix > width_ - 2) { c.ix = width_ - 2; c.tx = S(1); }
-  if (c.iz > depth_ - 2) { c.iz = depth_ - 2; c.tz = S(1); }
+  if (c.ix < 0) {
+    c.ix = 0;
+    c.tx = S(0);
+  }
+  if (c.iz < 0) {
+    c.iz = 0;
+    c.tz = S(0);
+  }
+  if (c.ix > width_ - 2) {
+    c.ix = width_ - 2;
+    c.tx = S(1);
+  }
+  if (c.iz > depth_ - 2) {
+    c.iz = depth_ - 2;
+    c.tz = S(1);
+  }
   return c;
 }
 
@@ -51,7 +63,9 @@ S Terrain<S>::heightAt(S x, S z) const {
 template <class S>
 void Terrain<S>::normalAt(S x, S z, S* nx, S* ny, S* nz) const {
   if (flat_) {
-    *nx = S(0); *ny = S(1); *nz = S(0);
+    *nx = S(0);
+    *ny = S(1);
+    *nz = S(0);
     return;
   }
   const Cell c = cellAt(x, z);

@@ -39,8 +39,12 @@ void computeRowAcceleration(const WindSchedule& schedule, const WindConstants<S>
   }
 }
 
-template void computeRowAcceleration(const WindSchedule&, const WindConstants<Fx32>&, int64_t, RowAccelerationDt<Fx32>*);
-template void computeRowAcceleration(const WindSchedule&, const WindConstants<Fx16>&, int64_t, RowAccelerationDt<Fx16>*);
-template void computeRowAcceleration(const WindSchedule&, const WindConstants<float>&, int64_t, RowAccelerationDt<float>*);
-template void computeRowAcceleration(const WindSchedule&, const WindConstants<double>&, int64_t, RowAccelerationDt<double>*);
+template void computeRowAcceleration(const WindSchedule&, const WindConstants<Fx32>&, int64_t,
+                                     RowAccelerationDt<Fx32>*);
+template void computeRowAcceleration(const WindSchedule&, const WindConstants<Fx16>&, int64_t,
+                                     RowAccelerationDt<Fx16>*);
+template void computeRowAcceleration(const WindSchedule&, const WindConstants<float>&, int64_t,
+                                     RowAccelerationDt<float>*);
+template void computeRowAcceleration(const WindSchedule&, const WindConstants<double>&, int64_t,
+                                     RowAccelerationDt<double>*);
 }  // namespace sg

@@ -18,9 +18,9 @@ namespace sg {
 
 struct WindSchedule {
   struct Gust {
-    int64_t startTick = 0;     ///< S_g: offset within the period
-    int64_t durationTicks = 0; ///< D_g
-    bool backward = false;     ///< reaches the last row first
+    int64_t startTick = 0;      ///< S_g: offset within the period
+    int64_t durationTicks = 0;  ///< D_g
+    bool backward = false;      ///< reaches the last row first
   };
   std::vector<Gust> gusts;
   int64_t periodTicks = 0;
@@ -53,7 +53,7 @@ struct RowAccelerationDt {
 template <class S>
 struct WindConstants {
   std::vector<S> forceX, forceY, forceZ;  ///< per gust, already multiplied by 1/mass
-  S accX{}, accY{}, accZ{};                ///< constant particle acceleration
+  S accX{}, accY{}, accZ{};               ///< constant particle acceleration
   S dt{};
 };
 

@@ -22,10 +22,10 @@ namespace sg {
 struct SimError {
   int64_t tick = -1;
   Stage stage = Stage::Count;
-  int64_t particle = -1;  ///< particle index, -1 if not particle-specific
-  int32_t body = -1;      ///< body index, -1 if not body-specific
+  int64_t particle = -1;               ///< particle index, -1 if not particle-specific
+  int32_t body = -1;                   ///< body index, -1 if not body-specific
   int64_t latticeI = 0, latticeJ = 0;  ///< patch coordinates of that particle
-  std::string what;        ///< "fixed-point overflow", "non-finite value", ...
+  std::string what;                    ///< "fixed-point overflow", "non-finite value", ...
   std::string message() const;
 };
 
@@ -39,6 +39,7 @@ class StateError : public std::runtime_error {
  public:
   StateError(uint64_t offset, const std::string& expected);
   uint64_t offset() const { return offset_; }
+
  private:
   uint64_t offset_;
 };
@@ -49,8 +50,8 @@ struct WorldCounts {
   int interpolation = 1;
   int threads = 1;
   int64_t bodies = 0;
-  int64_t contacts = 0;  ///< body contacts found in the last tick
-  bool lodWindow = false;                 ///< the level-of-detail window is on
+  int64_t contacts = 0;                            ///< body contacts found in the last tick
+  bool lodWindow = false;                          ///< the level-of-detail window is on
   int64_t windowPatchesX = 0, windowPatchesZ = 0;  ///< simulated patches (the field when off)
   int64_t windowOriginI = 0, windowOriginJ = 0;    ///< lattice patch of the window's first corner
   int64_t patches() const { return patchesX * patchesZ; }
@@ -87,7 +88,7 @@ struct StateExport {
   std::vector<double> tipOffset;  ///< x, y, z per patch: top-vertex centre minus root, m
   struct Body {
     std::array<double, 3> position{}, velocity{}, angularVelocity{};  ///< m, m/s, rad/s (world)
-    std::array<double, 4> orientation{};                               ///< w, x, y, z
+    std::array<double, 4> orientation{};                              ///< w, x, y, z
     int32_t templateBody = -1;  ///< the scenario body it is (or copies, when spawned)
     bool asleep = false;
     bool bladeOn = false;  ///< a mower whose blade is on

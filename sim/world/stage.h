@@ -7,29 +7,38 @@
 namespace sg {
 
 enum class Stage : uint8_t {
-  Window = 0,       ///< level-of-detail window follows the camera           (sim/lod)
-  Input,            ///< recorded body commands applied                      (sim/bodies)
-  Wind,             ///< per-row wind force and particle acceleration        (sim/wind)
-  Collision,        ///< body-body and body-terrain contacts                 (sim/collision)
-  Response,         ///< gravity, contact impulses, projection, grass push   (sim/collision)
-  Integrate,        ///< p += v dt; v += a dt; v *= damping^dt              (sim/particles)
-                    ///< fused per row with Constraints (particle_row.h): its time is timed here
-  Constraints,      ///< rod projection back to length L; names a projection fault (never timed)
-  PatchState,       ///< interpolation, tip offsets, tilt levels             (sim/patches)
+  Window = 0,   ///< level-of-detail window follows the camera           (sim/lod)
+  Input,        ///< recorded body commands applied                      (sim/bodies)
+  Wind,         ///< per-row wind force and particle acceleration        (sim/wind)
+  Collision,    ///< body-body and body-terrain contacts                 (sim/collision)
+  Response,     ///< gravity, contact impulses, projection, grass push   (sim/collision)
+  Integrate,    ///< p += v dt; v += a dt; v *= damping^dt              (sim/particles)
+                ///< fused per row with Constraints (particle_row.h): its time is timed here
+  Constraints,  ///< rod projection back to length L; names a projection fault (never timed)
+  PatchState,   ///< interpolation, tip offsets, tilt levels             (sim/patches)
   Count
 };
 
 inline const char* stageName(Stage s) {
   switch (s) {
-    case Stage::Window: return "window";
-    case Stage::Input: return "input";
-    case Stage::Wind: return "wind";
-    case Stage::Collision: return "collision";
-    case Stage::Response: return "response";
-    case Stage::Integrate: return "integrate";
-    case Stage::Constraints: return "constraints";
-    case Stage::PatchState: return "patch-state";
-    case Stage::Count: break;
+    case Stage::Window:
+      return "window";
+    case Stage::Input:
+      return "input";
+    case Stage::Wind:
+      return "wind";
+    case Stage::Collision:
+      return "collision";
+    case Stage::Response:
+      return "response";
+    case Stage::Integrate:
+      return "integrate";
+    case Stage::Constraints:
+      return "constraints";
+    case Stage::PatchState:
+      return "patch-state";
+    case Stage::Count:
+      break;
   }
   return "?";
 }

@@ -15,7 +15,9 @@ template <class S>
 S toS(const Rational& r) {
   // validateForScalar checks every value first; this guard turns a missed case into an error.
   const auto v = ScalarTraits<S>::fromRational(r);
-  if (!v) throw std::out_of_range(std::string("value ") + r.toString() + " does not fit " + scalarName(ScalarTraits<S>::kind));
+  if (!v)
+    throw std::out_of_range(std::string("value ") + r.toString() + " does not fit " +
+                            scalarName(ScalarTraits<S>::kind));
   return *v;
 }
 
@@ -116,7 +118,8 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
 
   // Rigid bodies.
   for (size_t i = 0; i < s.bodies.list.size(); ++i)
-    bodies_.push_back(makeBody<S>(s.bodies.list[i], s.timeStep, s.sourceName, "$.bodies.list[" + std::to_string(i) + "]"));
+    bodies_.push_back(
+        makeBody<S>(s.bodies.list[i], s.timeStep, s.sourceName, "$.bodies.list[" + std::to_string(i) + "]"));
   initialBodies_ = bodies_;
   gravityDt_ = Vec3<S>(toS<S>(s.bodies.gravity[0]), toS<S>(s.bodies.gravity[1]), toS<S>(s.bodies.gravity[2])) *
                particleConsts_.dt;
@@ -142,8 +145,8 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   // Patches and particles of the window: static attributes from the lattice hash, roots on the
   // terrain, particles at rest length straight up with the scenario's initial velocity.
   const size_t nPatches = size_t(patchWindow_.size());
-  for (auto* v : {&patches_.rootX, &patches_.rootY, &patches_.rootZ, &patches_.tipOffsetX, &patches_.tipOffsetZ,
-                  &patches_.topY})
+  for (auto* v :
+       {&patches_.rootX, &patches_.rootY, &patches_.rootZ, &patches_.tipOffsetX, &patches_.tipOffsetZ, &patches_.topY})
     v->assign(nPatches, S(0));
   patches_.rotation.assign(nPatches, 0);
   patches_.variant.assign(nPatches, 0);
@@ -156,7 +159,8 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
                              toS<S>(s.particles.initialVelocity[2]));
   if (lodWindow_) {
     // The window starts centred on lod.center (default: the field centre).
-    const Rational cx = s.lod.centerGiven ? s.lod.centerX : f.centerX, cz = s.lod.centerGiven ? s.lod.centerZ : f.centerZ;
+    const Rational cx = s.lod.centerGiven ? s.lod.centerX : f.centerX,
+                   cz = s.lod.centerGiven ? s.lod.centerZ : f.centerZ;
     startI = clampWindowOrigin(nearestParticleColumn(toS<S>(cx), lattice_.originX) - (grid_.countX - 1) / 2, true);
     startJ = clampWindowOrigin(nearestParticleColumn(toS<S>(cz), lattice_.originZ) - (grid_.countZ - 1) / 2, false);
   }
@@ -179,8 +183,9 @@ void World<S>::setThreads(int threads) {
 
 template <class S>
 WorldCounts World<S>::counts() const {
-  WorldCounts n{lattice_.patchesX, lattice_.patchesZ, grid_.countX, grid_.countZ, grid_.k, pool_->threads(),
-                int64_t(bodies_.size()), int64_t(contacts_.size())};
+  WorldCounts n{
+      lattice_.patchesX,       lattice_.patchesZ,        grid_.countX, grid_.countZ, grid_.k, pool_->threads(),
+      int64_t(bodies_.size()), int64_t(contacts_.size())};
   n.lodWindow = lodWindow_;
   n.windowPatchesX = patchWindow_.sizeI;
   n.windowPatchesZ = patchWindow_.sizeJ;

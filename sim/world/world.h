@@ -30,8 +30,8 @@
 #include "sim/terrain/terrain.h"
 #include "sim/wind/wind.h"
 #include "sim/world/chunk_pool.h"
-#include "sim/world/stage.h"
 #include "sim/world/sim_world.h"
+#include "sim/world/stage.h"
 #include "sim/world/tick_input.h"
 
 namespace sg {
@@ -74,7 +74,7 @@ class World final : public SimWorld {
   const WindSchedule& wind() const { return windSchedule_; }
   const RowAccelerationDt<S>& rowAcceleration() const { return rowAccel_; }
   const std::vector<RigidBody<S>>& bodies() const { return bodies_; }
-  std::vector<RigidBody<S>>& mutableBodies() { return bodies_; }  ///< tests: set up states
+  std::vector<RigidBody<S>>& mutableBodies() { return bodies_; }         ///< tests: set up states
   const std::vector<Contact<S>>& contacts() const { return contacts_; }  ///< last tick's
   const std::map<std::pair<int64_t, int64_t>, uint8_t>& cuts() const { return cuts_; }
   const ParticleConstants<S>& particleConstants() const { return particleConsts_; }
@@ -121,7 +121,7 @@ class World final : public SimWorld {
   LatticeWindow patchWindow_;  ///< which patches patches_ holds (toroidal, like the particles)
   bool lodWindow_ = false;     ///< the level-of-detail window is on (else the window is the field)
   Vec3<S> initialVelocity_ = Vec3<S>::Zero();
-  EdgeRing<S> edgeRing_;       ///< level 1 around the window (rows = 0 with the level of detail off)
+  EdgeRing<S> edgeRing_;  ///< level 1 around the window (rows = 0 with the level of detail off)
   ParticleGrid grid_;
   ParticleArrays<S> particles_;
   ParticleConstants<S> particleConsts_;

@@ -41,12 +41,13 @@ void World<S>::updatePatchesFromDisplacement() {
     S* scratch = rowScratch_.data() + size_t(worker) * size_t(3 * (grid_.countX + pw.sizeI));
     const int64_t j1 = pw.originJ + std::min(pw.sizeJ, (c + 1) * patchRowsPerChunk);
     for (int64_t j = pw.originJ + c * patchRowsPerChunk; j < j1; ++j)
-      exactRowWeights_ && grid_.k == 2 ? updatePatchRow<S, 2>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch, vector)
-      : exactRowWeights_ && grid_.k == 4 ? updatePatchRow<S, 4>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch, vector)
-                                          : updatePatchRow<S>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch);
+      exactRowWeights_&& grid_.k == 2
+          ? updatePatchRow<S, 2>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch, vector)
+      : exactRowWeights_&& grid_.k == 4
+          ? updatePatchRow<S, 4>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch, vector)
+          : updatePatchRow<S>(patches_, pw, j, grid_.window, dispX_, dispY_, dispZ_, patchConsts_, scratch);
   });
 }
-
 
 template <class S>
 StepResult World<S>::step(const TickInput& input, StageObserver* observer) {
@@ -144,17 +145,17 @@ bool World<S>::patchStage() {
   return true;
 }
 
-#define SG_INSTANTIATE_STEP(S) \
+#define SG_INSTANTIATE_STEP(S)                                          \
   template StepResult World<S>::step(const TickInput&, StageObserver*); \
-  template void World<S>::updatePatchState(); \
-  template void World<S>::updatePatchesFromDisplacement(); \
-  template bool World<S>::failWith(Stage, uint32_t); \
-  template bool World<S>::windowStage(const TickInput&); \
-  template bool World<S>::inputStage(const TickInput&); \
-  template bool World<S>::windStage(); \
-  template bool World<S>::collisionStage(); \
-  template bool World<S>::integrateStage(); \
-  template bool World<S>::patchStage(); \
+  template void World<S>::updatePatchState();                           \
+  template void World<S>::updatePatchesFromDisplacement();              \
+  template bool World<S>::failWith(Stage, uint32_t);                    \
+  template bool World<S>::windowStage(const TickInput&);                \
+  template bool World<S>::inputStage(const TickInput&);                 \
+  template bool World<S>::windStage();                                  \
+  template bool World<S>::collisionStage();                             \
+  template bool World<S>::integrateStage();                             \
+  template bool World<S>::patchStage();
 
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE_STEP)
 

@@ -47,7 +47,8 @@ int main(int argc, char** argv) {
     } else if (!std::strcmp(argv[i], "--scalar-kernel")) {
       scalarKernel = true;
     } else if (argv[i][0] == '-') {
-      std::fprintf(stderr, "usage: core_hash [--scalar fx32|fx16|float|double] [--ticks N] [--scalar-kernel] [scenario.json]\n");
+      std::fprintf(
+          stderr, "usage: core_hash [--scalar fx32|fx16|float|double] [--ticks N] [--scalar-kernel] [scenario.json]\n");
       return 2;
     } else {
       file = argv[i];
@@ -68,7 +69,7 @@ int main(int argc, char** argv) {
     }
     // Files a scenario names (its heightmap) are relative to the scenario.
     const sg::ScenarioFileReader reader = [&dir](const std::string& path, std::vector<uint8_t>* bytes,
-                                                  std::string* error) {
+                                                 std::string* error) {
       if (readBytes(dir + "/" + path, bytes)) return true;
       *error = "file '" + path + "' not found";
       return false;

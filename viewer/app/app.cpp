@@ -238,9 +238,9 @@ void App::handleToggles() {
     if (live_->recorder) {
       status_ = live_->stopRecording(&error) ? "saved " + live_->recordPath : error;
     } else {
-      const std::string path = "simgrass-" + live_->scenario.name + "-" +
-                               std::to_string(std::chrono::system_clock::now().time_since_epoch().count() / 1000000000) +
-                               ".sgr";
+      const std::string path =
+          "simgrass-" + live_->scenario.name + "-" +
+          std::to_string(std::chrono::system_clock::now().time_since_epoch().count() / 1000000000) + ".sgr";
       status_ = live_->startRecording(path, &error) ? "" : error;
     }
   }
@@ -339,7 +339,8 @@ bool App::screenshot(const std::string& path, std::string* error) {
   glfwGetFramebufferSize(window_, &fbw, &fbh);
   renderWorld(fbw, fbh);
   // The panels of the last frame (ImGui's draw data stays valid until the next NewFrame).
-  if (imgui_ && ImGui::GetDrawData() && ImGui::GetDrawData()->Valid) ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  if (imgui_ && ImGui::GetDrawData() && ImGui::GetDrawData()->Valid)
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
   Image img;
   img.width = fbw;
   img.height = fbh;

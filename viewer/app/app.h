@@ -125,8 +125,8 @@ class App {
   // Bodies.
   int selected_ = 0;
   bool positionMode_ = false;
-  std::vector<bool> mowerOn_;                ///< per body; mowers start cutting
-  std::vector<BodyCommand> pendingCommands_; ///< one-shot commands (reset, spawn, mower) for the next tick
+  std::vector<bool> mowerOn_;                 ///< per body; mowers start cutting
+  std::vector<BodyCommand> pendingCommands_;  ///< one-shot commands (reset, spawn, mower) for the next tick
   // Visuals.
   RenderOptions render_;
   bool interpolate_ = true;      ///< display interpolation (off in scripted runs)
@@ -137,7 +137,7 @@ class App {
   char openPath_[512] = "";
   bool scrubbing_ = false;  ///< the timeline slider is held
   int64_t scrubTick_ = 0;   ///< where it is held
-  std::string errorText_;  ///< the error window's line ("" when closed)
+  std::string errorText_;   ///< the error window's line ("" when closed)
   std::string status_;
   // Stats.
   double renderMs_ = 0, frameMs_ = 0;

@@ -89,10 +89,11 @@ std::string App::editedScenarioText() const {
   if (edits_.gustScale != 1 || edits_.gustPeriodScale != 1) {
     nlohmann::json schedule = nlohmann::json::array();
     for (const WindGust& g : s.wind.schedule)
-      schedule.push_back({{"force",
-                           {round6(g.force[0].toDouble() * edits_.gustScale), round6(g.force[1].toDouble() * edits_.gustScale),
-                            round6(g.force[2].toDouble() * edits_.gustScale)}},
-                          {"duration", round6(g.duration.toDouble() * edits_.gustPeriodScale)}});
+      schedule.push_back(
+          {{"force",
+            {round6(g.force[0].toDouble() * edits_.gustScale), round6(g.force[1].toDouble() * edits_.gustScale),
+             round6(g.force[2].toDouble() * edits_.gustScale)}},
+           {"duration", round6(g.duration.toDouble() * edits_.gustPeriodScale)}});
     j["wind"]["schedule"] = schedule;
   }
   if (edits_.heightmap[0] && edits_.heightmap != s.terrain.heightmapPath)
@@ -115,8 +116,10 @@ bool App::applyScenario(const std::string& text, bool replayHistory, const std::
   if (live_->recorder) {
     // The recording's scenario text no longer describes the session: end it where it stands.
     std::string e;
-    if (live_->stopRecording(&e)) note = "; the recording " + live_->recordPath + " was stopped";
-    else showError(e);
+    if (live_->stopRecording(&e))
+      note = "; the recording " + live_->recordPath + " was stopped";
+    else
+      showError(e);
   }
   play_.reset();
   live_ = std::move(next);

@@ -11,8 +11,8 @@ namespace sg::viewer {
 /// The `print` line: what tests compare with the CLI (state hash at a tick, counts, A/B numbers).
 void App::printState() const {
   const WorldCounts c = world().counts();
-  std::printf("state      tick %" PRId64 ", hash %s, patches %" PRId64 "x%" PRId64 ", bodies %" PRId64,
-              world().tick(), hex(world().stateHash()).c_str(), c.patchesX, c.patchesZ, c.bodies);
+  std::printf("state      tick %" PRId64 ", hash %s, patches %" PRId64 "x%" PRId64 ", bodies %" PRId64, world().tick(),
+              hex(world().stateHash()).c_str(), c.patchesX, c.patchesZ, c.bodies);
   if (play_) {
     std::printf(", playback %" PRId64 "/%" PRId64 ", hashes ok %" PRId64 ", mismatch %" PRId64, play_->tick(),
                 play_->lastTick(), play_->hashesOk(), play_->firstMismatchTick());
@@ -40,13 +40,18 @@ int App::runCommand(const ScriptCommand& c) {
   };
   using K = ScriptCommand::Kind;
   switch (c.kind) {
-    case K::Frames: return kGoOn;  // handled by the caller
-    case K::Key: scriptKeys_[size_t(c.key)] = c.down; return kGoOn;
-    case K::Camera: cam_.place(c.camera[0], c.camera[1], c.camera[2], c.camera[3], c.camera[4], ground()); return kGoOn;
+    case K::Frames:
+      return kGoOn;  // handled by the caller
+    case K::Key:
+      scriptKeys_[size_t(c.key)] = c.down;
+      return kGoOn;
+    case K::Camera:
+      cam_.place(c.camera[0], c.camera[1], c.camera[2], c.camera[3], c.camera[4], ground());
+      return kGoOn;
     case K::Select:
       if (c.count >= world().counts().bodies)
-        return bad("select " + std::to_string(c.count) + ": the scenario has " + std::to_string(world().counts().bodies) +
-                   " bodies");
+        return bad("select " + std::to_string(c.count) + ": the scenario has " +
+                   std::to_string(world().counts().bodies) + " bodies");
       selected_ = int(c.count);
       return kGoOn;
     case K::RecordStart:
@@ -59,7 +64,8 @@ int App::runCommand(const ScriptCommand& c) {
     case K::Screenshot:
       if (!screenshot(c.path, &error)) return failWith(kExitFailure, error);
       return kGoOn;
-    case K::Quit: return kExitOk;
+    case K::Quit:
+      return kExitOk;
     case K::Play:
     case K::Pause:
       if (!play_) return needPlayback(c.kind == K::Play ? "play" : "pause");
@@ -73,7 +79,8 @@ int App::runCommand(const ScriptCommand& c) {
     case K::Seek:
       if (!play_) return needPlayback("seek");
       if (c.count > play_->lastTick())
-        return bad("seek " + std::to_string(c.count) + ": expected a tick from 0 to " + std::to_string(play_->lastTick()));
+        return bad("seek " + std::to_string(c.count) + ": expected a tick from 0 to " +
+                   std::to_string(play_->lastTick()));
       if (!play_->seek(c.count, &error)) showError(error);
       return kGoOn;
     case K::Speed:
@@ -84,7 +91,9 @@ int App::runCommand(const ScriptCommand& c) {
       if (!play_ || !play_->hasB()) return bad("ab: expected A/B mode (--ab B.sgr or --ab-variant SETTINGS)");
       abView_ = c.count ? AbView::Overlay : AbView::Side;
       return kGoOn;
-    case K::Open: openFile(c.path); return kGoOn;  // a bad file: the error shown, the session goes on
+    case K::Open:
+      openFile(c.path);
+      return kGoOn;  // a bad file: the error shown, the session goes on
     case K::Set:
       try {
         // Staged like a panel edit: the next `regenerate` builds the world from it.
@@ -94,8 +103,7 @@ int App::runCommand(const ScriptCommand& c) {
         return bad(e.what());
       }
       return kGoOn;
-    case K::Regenerate:
-    {
+    case K::Regenerate: {
       const std::string text = stagedText_.empty() ? live_->scenario.text : stagedText_;
       stagedText_.clear();
       applyScenario(text, false, "regenerated");  // a bad edit: the error shown, the session goes on
@@ -112,7 +120,9 @@ int App::runCommand(const ScriptCommand& c) {
       applyScenario(text, true, c.count ? "level of detail on" : "level of detail off");
       return kGoOn;
     }
-    case K::Print: printState(); return kGoOn;
+    case K::Print:
+      printState();
+      return kGoOn;
   }
   return kGoOn;
 }

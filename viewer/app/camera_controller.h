@@ -11,11 +11,11 @@ namespace sg::viewer {
 
 /// Controls (docs/viewer.md).
 struct Tuning {
-  float walkSpeed = 4.0f;        ///< m/s (x4 with shift)
+  float walkSpeed = 4.0f;  ///< m/s (x4 with shift)
   float lookDegreesPerPixel = 0.15f;
-  float bodyAcceleration = 8.0f; ///< m/s^2 while a drive key is held (velocity mode)
-  float bodySpeed = 2.0f;        ///< m/s while a drive key is held (position mode)
-  float minEyeHeight = 0.3f;     ///< m above the terrain
+  float bodyAcceleration = 8.0f;  ///< m/s^2 while a drive key is held (velocity mode)
+  float bodySpeed = 2.0f;         ///< m/s while a drive key is held (position mode)
+  float minEyeHeight = 0.3f;      ///< m above the terrain
 };
 
 /// Movement keys held this frame (+1 / -1 / 0 per axis).

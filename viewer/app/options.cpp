@@ -27,8 +27,9 @@ int parseOptions(int argc, char** argv, Options* o) {
   app.add_option("--script", o->script, "Run a test script (frame-locked: one frame per tick)");
   app.add_option("--record", o->record, "Record the session from its first tick to this .sgr");
   app.add_option("--ab", o->abFile, "A/B mode: compare the recording with this second recording");
-  app.add_option("--ab-variant", o->abVariant,
-                 "A/B mode: compare the recording with itself re-simulated under these settings (interp=2, dt=1/120, ...)");
+  app.add_option(
+      "--ab-variant", o->abVariant,
+      "A/B mode: compare the recording with itself re-simulated under these settings (interp=2, dt=1/120, ...)");
   app.add_option("--frames", o->frames, "Quit after N frames")->check(CLI::NonNegativeNumber);
   app.add_option("--size", o->size, "Window size WxH (default 1280x720)");
   app.add_option("--msaa", o->msaa, "Samples per pixel: 0 (alpha test) or 2/4/8 (alpha to coverage; default 4)")
@@ -47,7 +48,8 @@ int parseOptions(int argc, char** argv, Options* o) {
     return kExitBadInput;
   }
   if (!parseSize(o->size, &o->width, &o->height)) {
-    std::fprintf(stderr, "simgrass-viewer: --size: expected WxH with both from 64 to 8192, got '%s'\n", o->size.c_str());
+    std::fprintf(stderr, "simgrass-viewer: --size: expected WxH with both from 64 to 8192, got '%s'\n",
+                 o->size.c_str());
     return kExitBadInput;
   }
   if (!o->abFile.empty() && !o->abVariant.empty()) {

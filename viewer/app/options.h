@@ -10,15 +10,15 @@ namespace sg::viewer {
 inline constexpr int kExitOk = 0, kExitFailure = 1, kExitBadInput = 2;
 
 struct Options {
-  std::string input;          ///< scenario JSON or recording (.sgr); empty: the built-in thesis meadow
+  std::string input;  ///< scenario JSON or recording (.sgr); empty: the built-in thesis meadow
   std::string script, record, size = "1280x720";
-  std::string abFile;         ///< --ab B.sgr: a second recording to compare with
-  std::string abVariant;      ///< --ab-variant SETTINGS: the same recording under a VariantSettings
+  std::string abFile;     ///< --ab B.sgr: a second recording to compare with
+  std::string abVariant;  ///< --ab-variant SETTINGS: the same recording under a VariantSettings
   int64_t frames = -1;
   int threads = 1;
   int msaa = 4;
   bool noScenarioInput = false;
-  bool keepOpenOnError = false;  ///< a bad input file opens the window with the error shown
+  bool keepOpenOnError = false;    ///< a bad input file opens the window with the error shown
   int width = 1280, height = 720;  ///< parsed from `size`
 };
 

@@ -102,7 +102,8 @@ void App::panelAb() {
   ImGui::SameLine();
   ImGui::RadioButton("divergence overlay (V)", &view, 1);
   abView_ = view == 0 ? AbView::Side : AbView::Overlay;
-  if (abView_ == AbView::Overlay) ImGui::SliderFloat("full scale m", &heatFullScale_, 0.001f, 1.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
+  if (abView_ == AbView::Overlay)
+    ImGui::SliderFloat("full scale m", &heatFullScale_, 0.001f, 1.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
   if (play_->measured()) {
     const TickDivergence& d = play_->divergence();
     ImGui::Text("tick %" PRId64 ": tip max %.3g m, RMS %.3g m", d.tick, d.tipMax, d.tipRms);

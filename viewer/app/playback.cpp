@@ -24,8 +24,9 @@ std::unique_ptr<Playback> Playback::open(const std::string& path, int threads) {
   p->threads_ = threads;
   p->rec_ = std::make_unique<sgr::Recording>(sgr::readRecording(path));
   if (p->rec_->truncated)  // the CLI's warning: what is there still plays
-    std::fprintf(stderr, "simgrass-viewer: warning: %s: byte %" PRIu64 ": expected %s; playing the %" PRId64
-                         " ticks before it\n",
+    std::fprintf(stderr,
+                 "simgrass-viewer: warning: %s: byte %" PRIu64 ": expected %s; playing the %" PRId64
+                 " ticks before it\n",
                  path.c_str(), p->rec_->truncatedAt, p->rec_->truncatedExpected.c_str(), p->rec_->lastTick());
   p->player_ = std::make_unique<Player>(*p->rec_, threads);
   p->hashesOwned_ = std::make_unique<RecordedHashes>(*p->rec_);
@@ -90,15 +91,14 @@ void Playback::syncB() {
   b_->world().observe(obsB_);
   last_ = measureDivergence(obsA_, obsB_, player_->world().stateHash() == b_->world().stateHash());
   measured_ = true;
-  if (last_.observedDifference() && (firstDivergent_ < 0 || t < firstDivergent_))
-    firstDivergent_ = t;
+  if (last_.observedDifference() && (firstDivergent_ < 0 || t < firstDivergent_)) firstDivergent_ = t;
 }
 
 void Playback::checkHash() {
   if (!player_->sameSettingsAsRecorded()) return;
   const int64_t t = tick();
-  const std::optional<uint64_t> want = t == rec_->header.startTick ? std::optional<uint64_t>(rec_->header.initialStateHash)
-                                                                   : hashes_->at(t);
+  const std::optional<uint64_t> want =
+      t == rec_->header.startTick ? std::optional<uint64_t>(rec_->header.initialStateHash) : hashes_->at(t);
   if (!want) return;
   const uint64_t got = player_->world().stateHash();
   if (*want == got) {

@@ -43,7 +43,8 @@ bool parseFloat(const std::string& s, float* v) {
 }
 }  // namespace
 
-bool parseScript(const std::string& text, const std::string& file, std::vector<ScriptCommand>* out, std::string* error) {
+bool parseScript(const std::string& text, const std::string& file, std::vector<ScriptCommand>* out,
+                 std::string* error) {
   std::istringstream in(text);
   std::string raw;
   int lineNo = 0;
@@ -73,9 +74,10 @@ bool parseScript(const std::string& text, const std::string& file, std::vector<S
     } else if (cmd == "key") {
       c.kind = ScriptCommand::Kind::Key;
       if (w.size() != 3 || (w[2] != "down" && w[2] != "up") || (c.key = scriptKeyCode(w[1])) < 0)
-        return fail("expected 'key K down|up' (K: a letter, a digit, tab, space, shift, ctrl, escape, backspace, "
-                    "period or home), got '" +
-                    shown + "'");
+        return fail(
+            "expected 'key K down|up' (K: a letter, a digit, tab, space, shift, ctrl, escape, backspace, "
+            "period or home), got '" +
+            shown + "'");
       c.down = w[2] == "down";
     } else if (cmd == "camera") {
       c.kind = ScriptCommand::Kind::Camera;
@@ -85,7 +87,8 @@ bool parseScript(const std::string& text, const std::string& file, std::vector<S
         return fail("expected 'camera x y z yaw pitch' (m, degrees; |pitch| <= 89), got '" + shown + "'");
     } else if (cmd == "select") {
       c.kind = ScriptCommand::Kind::Select;
-      if (w.size() != 2 || !parseCount(w[1], 1000000, &c.count)) return fail("expected 'select N', got '" + shown + "'");
+      if (w.size() != 2 || !parseCount(w[1], 1000000, &c.count))
+        return fail("expected 'select N', got '" + shown + "'");
     } else if (cmd == "record" && w.size() == 3 && w[1] == "start") {
       c.kind = ScriptCommand::Kind::RecordStart;
       c.path = w[2];
@@ -101,8 +104,8 @@ bool parseScript(const std::string& text, const std::string& file, std::vector<S
       c.kind = ScriptCommand::Kind::Quit;
       if (w.size() != 1) return fail("expected 'quit', got '" + shown + "'");
     } else if (cmd == "play" || cmd == "pause" || cmd == "regenerate" || cmd == "print") {
-      c.kind = cmd == "play" ? ScriptCommand::Kind::Play
-               : cmd == "pause" ? ScriptCommand::Kind::Pause
+      c.kind = cmd == "play"         ? ScriptCommand::Kind::Play
+               : cmd == "pause"      ? ScriptCommand::Kind::Pause
                : cmd == "regenerate" ? ScriptCommand::Kind::Regenerate
                                      : ScriptCommand::Kind::Print;
       if (w.size() != 1) return fail("expected '" + cmd + "' alone, got '" + shown + "'");
@@ -127,11 +130,13 @@ bool parseScript(const std::string& text, const std::string& file, std::vector<S
       c.count = w[1] == "overlay";
     } else if (cmd == "lod") {
       c.kind = ScriptCommand::Kind::Lod;
-      if (w.size() != 2 || (w[1] != "on" && w[1] != "off")) return fail("expected 'lod on' or 'lod off', got '" + shown + "'");
+      if (w.size() != 2 || (w[1] != "on" && w[1] != "off"))
+        return fail("expected 'lod on' or 'lod off', got '" + shown + "'");
       c.count = w[1] == "on";
     } else if (cmd == "open") {
       c.kind = ScriptCommand::Kind::Open;
-      if (w.size() != 2) return fail("expected 'open PATH' (a scenario .json or a recording .sgr), got '" + shown + "'");
+      if (w.size() != 2)
+        return fail("expected 'open PATH' (a scenario .json or a recording .sgr), got '" + shown + "'");
       c.path = w[1];
     } else if (cmd == "set") {
       c.kind = ScriptCommand::Kind::Set;

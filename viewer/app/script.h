@@ -11,20 +11,36 @@ namespace sg::viewer {
 
 struct ScriptCommand {
   enum class Kind {
-    Frames, Key, Camera, Select, RecordStart, RecordStop, Screenshot, Quit,
+    Frames,
+    Key,
+    Camera,
+    Select,
+    RecordStart,
+    RecordStop,
+    Screenshot,
+    Quit,
     // playback (a .sgr is open)
-    Play, Pause, Step, Seek, Speed, AbView,
+    Play,
+    Pause,
+    Step,
+    Seek,
+    Speed,
+    AbView,
     // files, panels, output
-    Open, Set, Regenerate, Lod, Print,
+    Open,
+    Set,
+    Regenerate,
+    Lod,
+    Print,
   } kind = Kind::Quit;
-  int64_t count = 0;      ///< frames N; select N; step N; seek T; lod 1|0; ab 0 (side) | 1 (overlay)
-  double number = 0;      ///< speed X
-  int key = 0;            ///< GLFW key code (key K down|up)
+  int64_t count = 0;  ///< frames N; select N; step N; seek T; lod 1|0; ab 0 (side) | 1 (overlay)
+  double number = 0;  ///< speed X
+  int key = 0;        ///< GLFW key code (key K down|up)
   bool down = false;
   float camera[5] = {0, 0, 0, 0, 0};  ///< x y z yaw pitch
-  std::string path;       ///< record start PATH; screenshot PATH; open PATH; set PATH (dotted JSON path)
-  std::string value;      ///< set PATH VALUE (JSON text)
-  int line = 0;           ///< 1-based line in the script file
+  std::string path;                   ///< record start PATH; screenshot PATH; open PATH; set PATH (dotted JSON path)
+  std::string value;                  ///< set PATH VALUE (JSON text)
+  int line = 0;                       ///< 1-based line in the script file
 };
 
 /// GLFW key code of a script key name: a letter or digit (case-insensitive), or tab, space,

@@ -53,7 +53,9 @@ std::unique_ptr<Session> Session::rebuilt(const std::string& text, bool replayHi
   if (replayHistory)
     for (const TickInput& in : history) {
       const StepResult r = s->step(in);
-      if (!r.ok) throw ScenarioError(scenario.sourceName, "$", "a scenario the session so far replays under (" + r.error.message() + ")");
+      if (!r.ok)
+        throw ScenarioError(scenario.sourceName, "$",
+                            "a scenario the session so far replays under (" + r.error.message() + ")");
     }
   return s;
 }

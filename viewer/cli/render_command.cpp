@@ -47,12 +47,18 @@ bool parseDebugList(const std::string& list, viewer::DebugFlags* flags, std::str
   bool any = false;
   while (std::getline(in, item, ',')) {
     any = true;
-    if (item == "particles") flags->particles = true;
-    else if (item == "constraints") flags->constraints = true;
-    else if (item == "primitives") flags->primitives = true;
-    else if (item == "cells") flags->cells = true;
-    else if (item == "contacts") flags->contacts = true;
-    else return *bad = item, false;
+    if (item == "particles")
+      flags->particles = true;
+    else if (item == "constraints")
+      flags->constraints = true;
+    else if (item == "primitives")
+      flags->primitives = true;
+    else if (item == "cells")
+      flags->cells = true;
+    else if (item == "contacts")
+      flags->contacts = true;
+    else
+      return *bad = item, false;
   }
   if (!any || list.back() == ',') return *bad = "", false;
   return true;
@@ -215,8 +221,7 @@ viewer::Image contactSheet(const std::vector<viewer::Image>& thumbs, const std::
   }
   for (size_t k = 0; k < thumbs.size(); ++k) {
     const int ox = kGap + int(k % size_t(columns)) * (tw + kGap), oy = kGap + int(k / size_t(columns)) * (th + kGap);
-    for (int y = 0; y < th; ++y)
-      std::copy_n(thumbs[k].at(0, y), size_t(tw) * 4, sheet.at(ox, oy + y));
+    for (int y = 0; y < th; ++y) std::copy_n(thumbs[k].at(0, y), size_t(tw) * 4, sheet.at(ox, oy + y));
     drawNumber(sheet, ox + 3, oy + 3, ticks[k], 2);
   }
   return sheet;
@@ -264,15 +269,18 @@ int render(const RenderOptions& o) {
   if (!o.camera.empty()) {
     fixedCamera = parseCamera(o.camera);
     if (!fixedCamera)
-      return fail(kExitBadInput, "--camera: expected x,y,z,yaw,pitch (m, degrees; |pitch| <= 90), got '" + o.camera + "'");
+      return fail(kExitBadInput,
+                  "--camera: expected x,y,z,yaw,pitch (m, degrees; |pitch| <= 90), got '" + o.camera + "'");
   }
   if (o.msaa != 0 && o.msaa != 2 && o.msaa != 4 && o.msaa != 8)
     return fail(kExitBadInput, "--msaa: expected 0, 2, 4 or 8, got " + std::to_string(o.msaa));
   viewer::DebugFlags debug;
   std::string badItem;
   if (!parseDebugList(o.debug, &debug, &badItem))
-    return fail(kExitBadInput, "--debug: expected a comma list of particles, constraints, primitives, cells, contacts, got '" +
-                                   o.debug + "'" + (badItem.empty() || badItem == o.debug ? "" : " ('" + badItem + "' is none of them)"));
+    return fail(kExitBadInput,
+                "--debug: expected a comma list of particles, constraints, primitives, cells, contacts, got '" +
+                    o.debug + "'" +
+                    (badItem.empty() || badItem == o.debug ? "" : " ('" + badItem + "' is none of them)"));
 
   // ---- the world ----
   Scenario scenario;
@@ -297,9 +305,7 @@ int render(const RenderOptions& o) {
     return fail(kExitBadInput, e.what());
   }
   SimWorld& world = player ? player->world() : *ownWorld;
-  auto inputAt = [&](int64_t tick) {
-    return recording ? recording->inputAt(tick) : scriptedInput(scenario, tick);
-  };
+  auto inputAt = [&](int64_t tick) { return recording ? recording->inputAt(tick) : scriptedInput(scenario, tick); };
 
   std::error_code ec;
   fs::create_directories(o.output, ec);

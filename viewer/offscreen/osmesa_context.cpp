@@ -52,8 +52,17 @@ extern "C" __attribute__((visibility("default"), used)) const char* __lsan_defau
 namespace sg::viewer {
 
 std::unique_ptr<OsmesaContext> OsmesaContext::create(std::string* error) {
-  const int attributes[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_PROFILE, OSMESA_CORE_PROFILE,
-                            OSMESA_CONTEXT_MAJOR_VERSION, 3, OSMESA_CONTEXT_MINOR_VERSION, 3, 0};
+  const int attributes[] = {OSMESA_FORMAT,
+                            OSMESA_RGBA,
+                            OSMESA_DEPTH_BITS,
+                            24,
+                            OSMESA_PROFILE,
+                            OSMESA_CORE_PROFILE,
+                            OSMESA_CONTEXT_MAJOR_VERSION,
+                            3,
+                            OSMESA_CONTEXT_MINOR_VERSION,
+                            3,
+                            0};
   OSMesaContext ctx = OSMesaCreateContextAttribs(attributes, nullptr);
   if (!ctx) {
     if (error) *error = "OSMesa: cannot create an OpenGL 3.3 core context (OSMesaCreateContextAttribs failed)";

@@ -44,7 +44,7 @@ class OsmesaContext {
 
  private:
   OsmesaContext() = default;
-  void* context_ = nullptr;   ///< OSMesaContext
+  void* context_ = nullptr;                  ///< OSMesaContext
   std::unique_ptr<unsigned char[]> buffer_;  ///< the (tiny) default framebuffer; we draw into FBOs
   int maxSamples_ = 0;
 };

@@ -105,10 +105,10 @@ struct Vec2 {
 };
 
 struct Blade {
-  Vec2 p0, p1, p2;    ///< quadratic Bézier, base -> tip (tile texels, y down)
-  float halfWidth;    ///< at the base
-  Rgb base, tip;      ///< linear colours
-  float litSide;      ///< +1 / -1: the side facing the light
+  Vec2 p0, p1, p2;  ///< quadratic Bézier, base -> tip (tile texels, y down)
+  float halfWidth;  ///< at the base
+  Rgb base, tip;    ///< linear colours
+  float litSide;    ///< +1 / -1: the side facing the light
 };
 
 /// A tuft: premultiplied linear RGBA floats, tileSize x tileSize, row 0 at the top.
@@ -118,10 +118,10 @@ struct TuftLayer {
 };
 
 struct TuftStyle {
-  Rgb base, tip;          ///< linear colours at a blade's base and tip
-  float hueJitter;        ///< per-blade red/blue jitter (linear)
-  float valueJitter;      ///< per-blade relative brightness jitter
-  float depthShade;       ///< how much darker the backmost blade is than the frontmost
+  Rgb base, tip;      ///< linear colours at a blade's base and tip
+  float hueJitter;    ///< per-blade red/blue jitter (linear)
+  float valueJitter;  ///< per-blade relative brightness jitter
+  float depthShade;   ///< how much darker the backmost blade is than the frontmost
 };
 
 constexpr int kSegments = 20;
@@ -133,7 +133,8 @@ void paintBlade(TuftLayer& layer, const Blade& blade) {
   for (int i = 0; i <= kSegments; ++i) {
     const float t = float(i) / float(kSegments);
     const float a = (1 - t) * (1 - t), b = 2 * (1 - t) * t, c = t * t;
-    pts[size_t(i)] = {a * blade.p0.x + b * blade.p1.x + c * blade.p2.x, a * blade.p0.y + b * blade.p1.y + c * blade.p2.y};
+    pts[size_t(i)] = {a * blade.p0.x + b * blade.p1.x + c * blade.p2.x,
+                      a * blade.p0.y + b * blade.p1.y + c * blade.p2.y};
     // Widest a little above the base, pointed tip.
     hw[size_t(i)] = blade.halfWidth * (0.85f + 0.15f * std::min(1.0f, t / 0.2f)) * std::pow(1.0f - t, 0.7f);
   }
@@ -259,7 +260,8 @@ void storeTile(Image& image, int x0, int y0, int padding, const TuftLayer& layer
       const float* src = layer.rgba.data() + (size_t(y) * size_t(n) + size_t(x)) * 4;
       const float a = src[3];
       // Alpha at or below 1/510 rounds to 0: such texels take the fill colour.
-      const Rgb c = a > 0.5f / 255.0f ? levelColour(Rgb{src[0] / a, src[1] / a, src[2] / a}, level, yellowing) : meanAtLevel;
+      const Rgb c =
+          a > 0.5f / 255.0f ? levelColour(Rgb{src[0] / a, src[1] / a, src[2] / a}, level, yellowing) : meanAtLevel;
       storeTexel(image.at(x0 + x, y0 + y), c, a);
     }
   }
@@ -316,7 +318,8 @@ float stretch(float n, float k) { return std::clamp((n - 0.5f) * k + 0.5f, 0.0f,
 
 TuftAtlas::Rect TuftAtlas::tile(int variant, int level) const {
   if (variant < 0 || variant > variants || level < 0 || level >= levels)
-    throw std::out_of_range("TuftAtlas::tile: no tile (" + std::to_string(variant) + ", " + std::to_string(level) + ")");
+    throw std::out_of_range("TuftAtlas::tile: no tile (" + std::to_string(variant) + ", " + std::to_string(level) +
+                            ")");
   const int cell = tileSize + 2 * padding;
   const float x = float(variant * cell + padding), y = float(level * cell + padding);
   const float w = float(image.width), h = float(image.height);
@@ -325,7 +328,8 @@ TuftAtlas::Rect TuftAtlas::tile(int variant, int level) const {
 
 std::array<float, 3> TuftAtlas::meanColour(int variant, int level) const {
   if (variant < 0 || variant > variants || level < 0 || level >= levels)
-    throw std::out_of_range("TuftAtlas::meanColour: no tile (" + std::to_string(variant) + ", " + std::to_string(level) + ")");
+    throw std::out_of_range("TuftAtlas::meanColour: no tile (" + std::to_string(variant) + ", " +
+                            std::to_string(level) + ")");
   const auto& decode = decodeTable();
   const int cell = tileSize + 2 * padding;
   const int x0 = variant * cell + padding, y0 = level * cell + padding;
@@ -344,9 +348,12 @@ std::array<float, 3> TuftAtlas::meanColour(int variant, int level) const {
 }
 
 TuftAtlas makeTuftAtlas(int variants, uint64_t seed, int tileSize, int padding) {
-  if (variants < 1 || variants > 16) throw std::invalid_argument("makeTuftAtlas: variants must be 1..16, got " + std::to_string(variants));
-  if (tileSize < 16 || tileSize > 1024) throw std::invalid_argument("makeTuftAtlas: tileSize must be 16..1024, got " + std::to_string(tileSize));
-  if (padding < 0 || padding > tileSize) throw std::invalid_argument("makeTuftAtlas: padding must be 0..tileSize, got " + std::to_string(padding));
+  if (variants < 1 || variants > 16)
+    throw std::invalid_argument("makeTuftAtlas: variants must be 1..16, got " + std::to_string(variants));
+  if (tileSize < 16 || tileSize > 1024)
+    throw std::invalid_argument("makeTuftAtlas: tileSize must be 16..1024, got " + std::to_string(tileSize));
+  if (padding < 0 || padding > tileSize)
+    throw std::invalid_argument("makeTuftAtlas: padding must be 0..tileSize, got " + std::to_string(padding));
   TuftAtlas atlas;
   atlas.variants = variants;
   atlas.levels = 4;
@@ -360,8 +367,10 @@ TuftAtlas makeTuftAtlas(int variants, uint64_t seed, int tileSize, int padding) 
   for (int v = 0; v <= variants; ++v) {
     const bool marking = v == variants;
     const uint64_t tuftSeed = hashOf(seed, marking ? 0x4D41524Bull /* "MARK" */ : uint64_t(v), 1);
-    const TuftLayer layer = paintTuft(tuftSeed, tileSize, marking ? markingStyle() : grassStyle(hashOf(seed, uint64_t(v), 2)));
-    for (int l = 0; l < atlas.levels; ++l) storeTile(atlas.image, v * cell + padding, l * cell + padding, padding, layer, l, marking ? 0.25f : 1.0f);
+    const TuftLayer layer =
+        paintTuft(tuftSeed, tileSize, marking ? markingStyle() : grassStyle(hashOf(seed, uint64_t(v), 2)));
+    for (int l = 0; l < atlas.levels; ++l)
+      storeTile(atlas.image, v * cell + padding, l * cell + padding, padding, layer, l, marking ? 0.25f : 1.0f);
   }
   // The area outside the grid (power-of-two rounding): transparent, level-0 grass colour, so the
   // smallest mipmaps are not darkened by it.
@@ -377,7 +386,8 @@ TuftAtlas makeTuftAtlas(int variants, uint64_t seed, int tileSize, int padding) 
 
 Image makeGroundTexture(const TuftAtlas& atlas, uint64_t seed, int size) {
   if (size < 4 || size > 8192 || (size & (size - 1)) != 0)
-    throw std::invalid_argument("makeGroundTexture: size must be a power of two in 4..8192, got " + std::to_string(size));
+    throw std::invalid_argument("makeGroundTexture: size must be a power of two in 4..8192, got " +
+                                std::to_string(size));
   std::vector<Rgb> palette;
   for (int v = 0; v < atlas.variants; ++v) {
     const auto m = atlas.meanColour(v, 0);
@@ -468,7 +478,8 @@ bool writePng(const std::string& path, const Image& image, std::string* error) {
     return fail("not a valid RGBA image (" + std::to_string(image.width) + " x " + std::to_string(image.height) + ")");
   errno = 0;
   if (stbi_write_png(path.c_str(), image.width, image.height, 4, image.rgba.data(), image.width * 4) == 0)
-    return fail(std::string("cannot write PNG") + (errno != 0 ? std::string(" (") + std::strerror(errno) + ")" : std::string()));
+    return fail(std::string("cannot write PNG") +
+                (errno != 0 ? std::string(" (") + std::strerror(errno) + ")" : std::string()));
   return true;
 }
 

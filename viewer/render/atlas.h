@@ -36,11 +36,11 @@ struct Image {
 };
 
 struct TuftAtlas {
-  Image image;        ///< power-of-two sides
-  int variants = 4;   ///< grass tuft variants (columns 0..variants-1); column `variants`: marking tuft
-  int levels = 4;     ///< brightness levels (rows)
-  int tileSize = 128; ///< texels per tile side, without padding
-  int padding = 8;    ///< texels of padding around every tile
+  Image image;         ///< power-of-two sides
+  int variants = 4;    ///< grass tuft variants (columns 0..variants-1); column `variants`: marking tuft
+  int levels = 4;      ///< brightness levels (rows)
+  int tileSize = 128;  ///< texels per tile side, without padding
+  int padding = 8;     ///< texels of padding around every tile
   struct Rect {
     float u0, v0, u1, v1;  ///< texture coordinates of the tile's inner square (v0 at the top)
   };

@@ -65,7 +65,8 @@ bool parseObjMesh(const std::string& text, const std::string& name, ObjMesh* out
       if (w.size() < 4) return fail(std::string(w[0] == "v" ? "'v x y z'" : "'vn x y z'") + " (3 numbers)");
       float xyz[3];
       for (int a = 0; a < 3; ++a)
-        if (!parseFloat(w[size_t(a) + 1], &xyz[a])) return fail("a finite number, got '" + std::string(w[size_t(a) + 1]) + "'");
+        if (!parseFloat(w[size_t(a) + 1], &xyz[a]))
+          return fail("a finite number, got '" + std::string(w[size_t(a) + 1]) + "'");
       auto& dst = w[0] == "v" ? v : vn;
       if (dst.size() / 3 >= kMaxVertices) return fail("at most " + std::to_string(kMaxVertices) + " vertices");
       dst.insert(dst.end(), xyz, xyz + 3);
@@ -81,8 +82,8 @@ bool parseObjMesh(const std::string& text, const std::string& name, ObjMesh* out
         Corner corner;
         corner.v = resolveIndex(c.substr(0, s1), v.size() / 3);
         if (corner.v < 0)
-          return fail("a vertex index in 1.." + std::to_string(v.size() / 3) + " (or -1..-" + std::to_string(v.size() / 3) +
-                      "), got '" + std::string(c) + "'");
+          return fail("a vertex index in 1.." + std::to_string(v.size() / 3) + " (or -1..-" +
+                      std::to_string(v.size() / 3) + "), got '" + std::string(c) + "'");
         if (s1 != std::string_view::npos) {
           const std::string_view rest = c.substr(s1 + 1);
           const size_t s2 = rest.find('/');

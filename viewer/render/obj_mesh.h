@@ -13,10 +13,10 @@ namespace sg::viewer {
 
 struct ObjMesh {
   /// Unindexed-friendly triangle soup made indexable: position + unit normal per vertex.
-  std::vector<float> positions;  ///< x, y, z per vertex
-  std::vector<float> normals;    ///< x, y, z per vertex (unit)
-  std::vector<uint32_t> indices; ///< 3 per triangle
-  size_t objVertices = 0;        ///< `v` lines read
+  std::vector<float> positions;   ///< x, y, z per vertex
+  std::vector<float> normals;     ///< x, y, z per vertex (unit)
+  std::vector<uint32_t> indices;  ///< 3 per triangle
+  size_t objVertices = 0;         ///< `v` lines read
   size_t triangles() const { return indices.size() / 3; }
 };
 

@@ -32,16 +32,16 @@ struct Lighting {
   std::array<float, 3> sunColour{0.80f, 0.78f, 0.70f};
   std::array<float, 3> ambient{0.42f, 0.45f, 0.50f};
   std::array<float, 3> zenith{0.26f, 0.46f, 0.78f};
-  std::array<float, 3> horizon{0.74f, 0.83f, 0.92f};        ///< also the fog colour
-  float fogDensity = 1.0f / 170.0f;                         ///< 1/m (exp2 fog)
-  float groundTileMetres = 3.0f;                            ///< one ground-texture repeat
-  float groundShade = 0.9f;                                 ///< the ground lies in the tufts' shade
+  std::array<float, 3> horizon{0.74f, 0.83f, 0.92f};  ///< also the fog colour
+  float fogDensity = 1.0f / 170.0f;                   ///< 1/m (exp2 fog)
+  float groundTileMetres = 3.0f;                      ///< one ground-texture repeat
+  float groundShade = 0.9f;                           ///< the ground lies in the tufts' shade
   /// Slopes (degrees) where the ground blends from grass to rock: starts, complete. Gentle by
   /// default because the repository's hills (hilly-meadow) peak at 15 degrees; real meadows grow
   /// on 30 degrees, so a rougher terrain may want {30, 45}.
   std::array<float, 2> rockSlopeDegrees{9.0f, 14.0f};
-  float ssaoRadius = 0.5f;                                  ///< m: the SSAO neighbourhood
-  float ssaoStrength = 1.2f;                                ///< 1: all samples occluded -> no ambient
+  float ssaoRadius = 0.5f;    ///< m: the SSAO neighbourhood
+  float ssaoStrength = 1.2f;  ///< 1: all samples occluded -> no ambient
 };
 
 /// An offscreen framebuffer: colour + depth, multisampled when samples > 0 (resolved on read).

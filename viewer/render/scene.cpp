@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <atomic>
-#include <set>
 #include <cctype>
 #include <cmath>
+#include <set>
 #include <string>
 
 #include "sim/collision/body_particles.h"
@@ -66,8 +66,11 @@ void paint(BodyPartDraw& d, const std::string& name, bool mower, size_t bodyInde
   if (nameHas(name, "rock") || nameHas(name, "stone")) return setColour(d, 0.46f, 0.44f, 0.41f);
   if (nameHas(name, "crate")) return setColour(d, 0.60f, 0.42f, 0.22f);
   if (d.shape == BodyPartDraw::Shape::Box && nameHas(name, "box")) return setColour(d, 0.60f, 0.42f, 0.22f);
-  static const float palette[][3] = {{0.25f, 0.40f, 0.75f}, {0.80f, 0.60f, 0.15f}, {0.55f, 0.25f, 0.60f},
-                                     {0.20f, 0.60f, 0.60f}, {0.75f, 0.35f, 0.30f}};
+  static const float palette[][3] = {{0.25f, 0.40f, 0.75f},
+                                     {0.80f, 0.60f, 0.15f},
+                                     {0.55f, 0.25f, 0.60f},
+                                     {0.20f, 0.60f, 0.60f},
+                                     {0.75f, 0.35f, 0.30f}};
   const auto& c = palette[bodyIndex % (sizeof palette / sizeof palette[0])];
   setColour(d, c[0], c[1], c[2]);
 }
@@ -249,7 +252,6 @@ void extractTyped(const World<S>& w, const Scenario& scenario, Scene* scene) {
   }
 }
 
-
 // ---- debug overlay ---------------------------------------------------------------------------
 
 using Line = DebugScene::Line;
@@ -350,8 +352,8 @@ void extractDebugTyped(const World<S>& w, const Scenario& scenario, const DebugF
     for (const auto& [b, a] : cells) {
       const double x0 = ox + (double(a) - 0.5) * ks, x1 = x0 + ks, z0 = oz + (double(b) - 0.5) * ks, z1 = z0 + ks;
       const float y = float(toD(w.terrain().heightAt(fromD<S>(0.5 * (x0 + x1)), fromD<S>(0.5 * (z0 + z1))))) + 0.02f;
-      const float corners[4][3] = {{float(x0), y, float(z0)}, {float(x1), y, float(z0)}, {float(x1), y, float(z1)},
-                                   {float(x0), y, float(z1)}};
+      const float corners[4][3] = {
+          {float(x0), y, float(z0)}, {float(x1), y, float(z0)}, {float(x1), y, float(z1)}, {float(x0), y, float(z1)}};
       for (int k = 0; k < 4; ++k) addLine(d, corners[k], corners[(k + 1) % 4], kCell);
     }
   }
@@ -463,11 +465,10 @@ void interpolateScene(const Scene& previous, const Scene& current, float alpha, 
     return;
   }
   // The same layout: the same window (origin and size) holds the same patches in the same slots.
-  const bool sameLayout = previous.simulatedTufts == current.simulatedTufts &&
-                          previous.tufts.size() >= previous.simulatedTufts &&
-                          previous.windowOriginI == current.windowOriginI &&
-                          previous.windowOriginJ == current.windowOriginJ &&
-                          previous.windowWidth == current.windowWidth && previous.windowHeight == current.windowHeight;
+  const bool sameLayout =
+      previous.simulatedTufts == current.simulatedTufts && previous.tufts.size() >= previous.simulatedTufts &&
+      previous.windowOriginI == current.windowOriginI && previous.windowOriginJ == current.windowOriginJ &&
+      previous.windowWidth == current.windowWidth && previous.windowHeight == current.windowHeight;
   if (sameLayout)
     for (size_t k = 0; k < current.simulatedTufts; ++k) {
       const TuftInstance& a = previous.tufts[k];

@@ -20,14 +20,14 @@ namespace sg::viewer {
 /// One tuft quad (thesis §2): a vertical quad whose bottom edge is centred on the root, turned by
 /// `angle` about y; the top edge sits at `topY`, shifted by (tipX, tipZ). 36 bytes, uploaded as is.
 struct TuftInstance {
-  float x, y, z;        ///< root on the ground (m)
-  float halfWidth;      ///< m (scaleXZ; larger for edge-ring tufts)
-  float topY;           ///< m, world height of the top edge
-  float tipX, tipZ;     ///< m, top-edge shift from the root
-  float angle;          ///< radians (rotation / 65536 turns)
-  uint8_t variant;      ///< atlas column: 0..variants-1, variants = the white marking tuft
-  uint8_t level;        ///< atlas row: brightness 0..3 (tilt level; mown tufts are brightest)
-  uint8_t heat = 0;     ///< divergence overlay: 0 = none .. 255 = full scale (applyDivergenceHeat)
+  float x, y, z;     ///< root on the ground (m)
+  float halfWidth;   ///< m (scaleXZ; larger for edge-ring tufts)
+  float topY;        ///< m, world height of the top edge
+  float tipX, tipZ;  ///< m, top-edge shift from the root
+  float angle;       ///< radians (rotation / 65536 turns)
+  uint8_t variant;   ///< atlas column: 0..variants-1, variants = the white marking tuft
+  uint8_t level;     ///< atlas row: brightness 0..3 (tilt level; mown tufts are brightest)
+  uint8_t heat = 0;  ///< divergence overlay: 0 = none .. 255 = full scale (applyDivergenceHeat)
   uint8_t pad = 0;
 };
 
@@ -39,8 +39,8 @@ struct BodyPartDraw {
   enum class Shape : uint8_t { Sphere, Box, Mesh } shape = Shape::Sphere;
   enum class Pattern : uint8_t { Plain, Football } pattern = Pattern::Plain;
   Mat4 model = identity4();
-  float colour[3] = {0.8f, 0.8f, 0.8f};  ///< linear RGB albedo
-  std::string mesh;                       ///< Shape::Mesh: OBJ path (relative: the asset directory)
+  float colour[3] = {0.8f, 0.8f, 0.8f};     ///< linear RGB albedo
+  std::string mesh;                         ///< Shape::Mesh: OBJ path (relative: the asset directory)
   uint32_t firstProxy = 0, proxyCount = 0;  ///< Shape::Mesh: the body's primitive parts in
                                             ///< Scene::meshProxies (the fallback when the mesh fails)
 };
@@ -79,7 +79,7 @@ struct Scene {
   std::vector<BodyPartDraw> bodyParts;
   std::vector<BodyPartDraw> meshProxies;  ///< primitives of mesh bodies (drawn if a mesh fails)
   GroundGrid ground;
-  DebugScene debug;                 ///< overlay (extractDebug; drawn per RenderOptions::debug)
+  DebugScene debug;  ///< overlay (extractDebug; drawn per RenderOptions::debug)
   /// The simulated tufts' layout: the LOD window's first patch (i, j) and size, and the field's
   /// patch columns. Two scenes with equal layouts hold the same patches in the same slots.
   int64_t windowOriginI = 0, windowOriginJ = 0, windowWidth = 0, windowHeight = 0;
