@@ -2,8 +2,10 @@
 //
 //   fx32   Q32.32  reference for bit-exact replay (default)
 //   fx16   Q16.16  fast variant, range about +-32 km, resolution 1.5e-5
-//   float  IEEE binary32   comparison (same-binary reproducibility only)
-//   double IEEE binary64   accuracy reference (same-binary reproducibility only)
+//   float  IEEE binary32   comparison
+//   double IEEE binary64   accuracy reference
+// float/double reproduce across builds and architectures only under the build's rules
+// (-ffp-contract=off, EIGEN_DONT_VECTORIZE, SSE2 on i686): docs/determinism.md.
 #pragma once
 
 #include <cmath>

@@ -3,8 +3,8 @@
 //
 // Invariants (each one a test in tests/):
 //   * same scenario + same inputs => the same stateHash() after every tick, for any thread
-//     count, build type, compiler and particle kernel (fixed types; float/double: same binary
-//     only);
+//     count, build type, compiler, architecture and particle kernel (float/double: with the
+//     build's flags, docs/determinism.md);
 //   * saveState() -> restoreState() into a fresh world -> continue == never interrupted;
 //   * nothing inside step() reads a clock, a random generator or libm.
 #pragma once
