@@ -232,7 +232,7 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
                            const std::vector<S>& dz, const PatchStateConstants<S>& c, S* scratch, bool vector = false) {
   const int k = K != 0 ? K : c.k;
   const S* weight = c.weight.data();
-  auto weightOf = [weight](int t) {
+  auto weightOf = [&](int t) {  // [&]: `weight` is unused when K != 0 (a named capture warns)
     if constexpr (K != 0)
       return powerOfTwoWeight<S, K>(t);
     else
@@ -240,7 +240,7 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
   };
   // K = 0 is the reference: Fixed's checked operators. K = 2, 4 compute the same bits unchecked.
   constexpr bool kFast = K != 0 && ScalarTraits<S>::isFixed;
-  auto blend = [&weightOf](S a, S b, int t) {
+  auto blend = [&](S a, S b, int t) {
     if constexpr (kFast)
       return unchecked::lerpByFraction<S, K>(a, b, t);
     else

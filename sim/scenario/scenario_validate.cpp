@@ -142,9 +142,13 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
       const std::string q = "$.bodies.list[" + std::to_string(i) + "]";
       for (int c = 0; c < 3; ++c) {
         const std::string ix = "[" + std::to_string(c) + "]";
-        fits(b.position[size_t(c)], q + ".position" + ix);
-        fits(b.velocity[size_t(c)], q + ".velocity" + ix);
-        fits(b.angularVelocity[size_t(c)], q + ".angularVelocity" + ix);
+        for (const auto& [name, value] : {std::pair{".position", &b.position}, std::pair{".velocity", &b.velocity},
+                                          std::pair{".angularVelocity", &b.angularVelocity}}) {
+          std::string path = q;
+          path += name;
+          path += ix;
+          fits((*value)[size_t(c)], path);
+        }
       }
       for (int c = 0; c < 4; ++c) fits(b.orientation[size_t(c)], q + ".orientation[" + std::to_string(c) + "]");
       for (size_t k = 0; k < b.parts.size(); ++k) {

@@ -108,7 +108,8 @@ bool parseScript(const std::string& text, const std::string& file, std::vector<S
                : cmd == "pause"      ? ScriptCommand::Kind::Pause
                : cmd == "regenerate" ? ScriptCommand::Kind::Regenerate
                                      : ScriptCommand::Kind::Print;
-      if (w.size() != 1) return fail("expected '" + cmd + "' alone, got '" + shown + "'");
+      if (w.size() != 1)
+        return fail(std::string("expected '").append(cmd).append("' alone, got '").append(shown).append("'"));
     } else if (cmd == "step") {
       c.kind = ScriptCommand::Kind::Step;
       if (w.size() != 2 || !parseCount(w[1], 100000000, &c.count))

@@ -72,7 +72,7 @@ std::unique_ptr<OsmesaContext> OsmesaContext::create(std::string* error) {
   c->context_ = ctx;
   // The default framebuffer is never drawn to (the renderer uses its own FBOs): keep it tiny.
   constexpr int kSide = 4;  // (makeCurrent() uses the same size)
-  c->buffer_ = std::make_unique<unsigned char[]>(kSide * kSide * 4);
+  c->buffer_ = std::make_unique<unsigned char[]>(size_t(kSide) * kSide * 4);
   if (!OSMesaMakeCurrent(ctx, c->buffer_.get(), GL_UNSIGNED_BYTE, kSide, kSide)) {
     if (error) *error = "OSMesa: OSMesaMakeCurrent failed";
     return nullptr;  // the destructor destroys the context
