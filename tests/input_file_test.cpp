@@ -10,18 +10,16 @@
 #include <fstream>
 #include <string>
 
-
 namespace sg {
 namespace {
 std::string scratch(const std::string& leaf) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("sg_input_file_" + std::to_string(getpid()));
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("sg_input_file_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
   return (dir / leaf).string();
 }
 
-void writeText(const std::string& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
-}
+void writeText(const std::string& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
 
 TEST(InputFile, ReadsARegularFileWhole) {
   const std::string p = scratch("ok.txt");
