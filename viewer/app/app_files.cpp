@@ -37,6 +37,7 @@ bool App::openFile(const std::string& path) {
   pendingCommands_.clear();
   accumulator_ = 0;
   errorText_.clear();
+  stagedJson_.reset();  // `set` edits staged for the previous scenario
   resetEdits();
   extractScene(world(), scenario(), &scene_);
   cam_.camera = defaultCamera(scene_, world());

@@ -1,28 +1,42 @@
 #include "viewer/app/playback.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <stdexcept>
 
+#include "replay/format/sgr_reader.h"
+#include "replay/input_file.h"
 #include "viewer/app/text.h"
 
 namespace sg::viewer {
 
 bool looksLikeRecording(const std::string& path) {
   if (path.size() >= 4 && path.compare(path.size() - 4, 4, ".sgr") == 0) return true;
-  std::ifstream in(path, std::ios::binary);
-  char magic[sizeof sgr::kMagic] = {};
-  return in.read(magic, sizeof magic) && std::memcmp(magic, sgr::kMagic, sizeof magic) == 0;
+  // The bounded reader: a FIFO, a directory or a device is no recording (and opening it never
+  // blocks); the scenario loader then names what it is.
+  InputFile in;
+  std::string expected;
+  uint8_t magic[sizeof sgr::kMagic] = {};
+  return in.open(path, InputLimits::kRecordingBytes, &expected) && in.size() >= sizeof magic &&
+         in.readAt(0, magic, &expected) && std::memcmp(magic, sgr::kMagic, sizeof magic) == 0;
+}
+
+sgr::Recording readRecordingFile(const std::string& path) {
+  std::vector<uint8_t> bytes;
+  std::string expected;
+  if (!readInputFile(path, InputLimits::kRecordingBytes, &bytes, &expected))
+    throw sgr::RecordingError(path, 0, expected);
+  return sgr::parseRecording(std::move(bytes), path);
 }
 
 std::unique_ptr<Playback> Playback::open(const std::string& path, int threads) {
   std::unique_ptr<Playback> p(new Playback());
   p->threads_ = threads;
-  p->rec_ = std::make_unique<sgr::Recording>(sgr::readRecording(path));
+  p->rec_ = std::make_unique<sgr::Recording>(readRecordingFile(path));
   if (p->rec_->truncated)  // the CLI's warning: what is there still plays
     std::fprintf(stderr,
                  "simgrass-viewer: warning: %s: byte %" PRIu64 ": expected %s; playing the %" PRId64
@@ -36,7 +50,7 @@ std::unique_ptr<Playback> Playback::open(const std::string& path, int threads) {
 }
 
 void Playback::attachRecording(const std::string& path) {
-  recB_ = std::make_unique<sgr::Recording>(sgr::readRecording(path));
+  recB_ = std::make_unique<sgr::Recording>(readRecordingFile(path));
   const Rational dtA = recordedTimeStep(*rec_), dtB = recordedTimeStep(*recB_);
   if (!(dtA == dtB))
     throw std::invalid_argument(path + ": expected a recording with A's time step " + dtA.toString() + ", got " +
@@ -113,25 +127,24 @@ void Playback::checkHash() {
 }
 
 bool Playback::step(int64_t n, std::string* error) {
-  for (int64_t i = 0; i < n && tick() < lastTick(); ++i) {
-    const StepResult r = player_->stepForward();
-    if (!r.ok) {
-      *error = r.error.message();
-      playing = false;
-      return false;
-    }
-    checkHash();
-    syncB();
-  }
-  return true;
+  if (n <= 0 || tick() >= lastTick()) return true;
+  target_ = tick() + std::min(n, lastTick() - tick());
+  checkEachTick_ = true;
+  return work(0, error);  // one tick now (a single step is immediate), the rest frame by frame
 }
 
 bool Playback::advance(double wallTicks, std::string* error) {
-  if (!playing) return true;
+  if (!playing || busy()) return true;
   accumulator_ += wallTicks * speed;
   const int64_t n = int64_t(std::floor(accumulator_));
   accumulator_ -= double(n);
-  const bool ok = step(n, error);
+  bool ok = true;
+  for (int64_t i = 0; ok && i < n && tick() < lastTick(); ++i) {
+    target_ = tick() + 1;
+    checkEachTick_ = true;
+    ok = work(0, error);
+  }
+  if (!ok) playing = false;
   if (tick() >= lastTick()) {
     playing = false;
     accumulator_ = 0;
@@ -142,18 +155,62 @@ bool Playback::advance(double wallTicks, std::string* error) {
 bool Playback::seek(int64_t t, std::string* error) {
   t = std::clamp<int64_t>(t, rec_->header.startTick, lastTick());
   accumulator_ = 0;
+  target_ = -1;
+  // The jump now (what Player::seek does first): the nearest snapshot at or before t, or the
+  // start, unless stepping on from here is shorter. Player::seek to that tick restores it and
+  // steps nothing; the steps from there to t are work()'s.
+  const sgr::SnapshotInfo* snap = hashesComparable() ? rec_->snapshotAtOrBefore(t) : nullptr;
+  const int64_t from = tick();
+  const bool forwardIsShorter = from <= t && (!snap || snap->tick <= from);
   try {
-    const StepResult r = player_->seek(t);
-    if (!r.ok) {
-      *error = r.error.message();
-      return false;
+    if (!forwardIsShorter) {
+      const StepResult r = player_->seek(snap ? snap->tick : rec_->header.startTick);
+      if (!r.ok) {
+        *error = r.error.message();
+        return false;
+      }
     }
   } catch (const sgr::RecordingError& e) {
     *error = e.what();
     return false;
   }
-  checkHash();
-  syncB();
+  if (tick() == t) {
+    checkHash();
+    syncB();
+    return true;
+  }
+  target_ = t;
+  checkEachTick_ = false;
+  return work(0, error);
+}
+
+bool Playback::work(double seconds, std::string* error) {
+  if (!busy()) return true;
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  do {
+    if (tick() >= target_) break;
+    StepResult r;
+    try {
+      r = player_->stepForward();
+    } catch (const sgr::RecordingError& e) {
+      target_ = -1;
+      playing = false;
+      *error = e.what();
+      return false;
+    }
+    if (!r.ok) {
+      target_ = -1;
+      playing = false;
+      *error = r.error.message();
+      return false;
+    }
+    if (checkEachTick_ || tick() >= target_) {
+      checkHash();
+      syncB();
+    }
+  } while (std::chrono::duration<double>(Clock::now() - start).count() < seconds);
+  if (tick() >= target_) target_ = -1;
   return true;
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 
@@ -45,9 +46,16 @@ class Session {
 };
 
 /// The scenario text with one value replaced: `dotted` is a path such as "field.patchesX" or
-/// "bodies.gravity", `value` any JSON value. Throws ScenarioError (file, "$.dotted", expected)
-/// when the text is not an object.
+/// "bodies.gravity" (a list takes an index up to its size; the size appends), `value` any JSON
+/// value. Throws ScenarioError (file, "$.dotted", expected) when the text is not an object, the
+/// path or value breaks EditLimits (text.h) or the value is not JSON; echoed text is truncated.
 std::string editScenarioText(const std::string& text, const std::string& sourceName, const std::string& dotted,
                              const std::string& valueJson);
+
+/// The same edit on an already parsed scenario (what repeated `set` lines stage, parsed once).
+void editScenarioJson(nlohmann::json* doc, const std::string& sourceName, const std::string& dotted,
+                      const std::string& valueJson);
+/// Parses scenario text for editing (depth bounded first). Throws ScenarioError unless an object.
+nlohmann::json parseScenarioJsonForEdit(const std::string& text, const std::string& sourceName);
 
 }  // namespace sg::viewer
