@@ -155,6 +155,39 @@ TEST(ViewerHardening, OutputsNeverReplaceAnInput) {
   EXPECT_EQ(readFile(rec), script) << "the script was overwritten";
 }
 
+TEST(ViewerHardening, ARecordingThatCannotBeWrittenStopsWithTheErrorShownAndTheSessionGoesOn) {
+  if (!onPath("xvfb-run")) GTEST_SKIP() << "xvfb-run is not on PATH";
+  TempDir dir;
+  const std::string scenario = smallScenario(dir), out = dir.file("out.sgr");
+  // The file-size limit (in KiB, SIGXFSZ ignored: writes fail with EFBIG as on a full disk) lets
+  // HEAD through and stops the recording some ticks later.
+  const std::string head = dir.file("head.sgr");
+  ASSERT_EQ(runCli("record " + quote(scenario) + " --ticks 0 -o " + quote(head)).exitCode, 0);
+  const uintmax_t limitKiB = fs::file_size(head) / 1024 + 1;
+  ASSERT_LT(fs::file_size(head) + 200, limitKiB * 1024) << "HEAD must fit with room for a few ticks";
+  const std::string script = dir.write("rec.txt", "record start " + out + "\nframes 60\nstatus\nprint\nquit\n");
+  const std::string stdoutFile = dir.file("stdout"), stderrFile = dir.file("stderr");
+  const std::string viewer = "trap '' XFSZ; ulimit -f " + std::to_string(limitKiB) + "; exec " +
+                             quote(SIMGRASS_VIEWER) + " " + quote(scenario) + " --script " + quote(script) + kWindow;
+  const std::string cmd = "env TMPDIR=" + quote(dir.file("")) +
+                          " timeout -k 5 120 xvfb-run -a -s '-screen 0 1024x768x24' bash -c " + quote(viewer) +
+                          " </dev/null >" + quote(stdoutFile) + " 2>" + quote(stderrFile);
+  const int status = std::system(cmd.c_str());
+  const std::string err = readFile(stderrFile), outText = readFile(stdoutFile);
+  ASSERT_TRUE(WIFEXITED(status)) << status;
+  EXPECT_EQ(WEXITSTATUS(status), 1) << err << outText;  // not a clean run: ticks went unrecorded
+  EXPECT_TRUE(isOneLine(err)) << err;
+  EXPECT_NE(err.find(out), std::string::npos) << err;
+  EXPECT_NE(err.find("the recording stopped there"), std::string::npos) << err;
+  const std::vector<std::string> shown = errorLines(outText);
+  ASSERT_EQ(shown.size(), 1u) << outText;
+  EXPECT_EQ(err, "simgrass-viewer: " + shown[0] + "\n");
+  EXPECT_NE(outText.find("state      tick 60,"), std::string::npos) << "the session went on: " << outText;
+  // What was written is a readable recording cut off before END (exit 3: everything in it checks).
+  const CliResult verify = runCli("replay " + quote(out) + " --verify");
+  EXPECT_EQ(verify.exitCode, 3) << verify.describe();
+}
+
 TEST(ViewerHardening, StepsAndSeeksStopAtTheRecordingsLastTick) {
   if (!onPath("xvfb-run")) GTEST_SKIP() << "xvfb-run is not on PATH";
   TempDir dir;

@@ -125,6 +125,7 @@ void App::close() {
 }
 
 int App::finish(int code) {
+  if (recordingFailed_ && code == kExitOk) code = kExitFailure;  // a recording lost ticks: not a clean run
   if (live_->recorder) {
     std::string e;
     if (!live_->stopRecording(&e) && code == kExitOk) {
@@ -292,6 +293,12 @@ bool App::simulate(double wall, std::string* error) {
     // The tick before the last of this frame is what display interpolation starts from.
     if (i + 1 == steps && interpolate_ && !scripted_) extractScene(world(), scenario(), &previous_);
     const StepResult r = live_->step(tickInput());
+    if (!live_->recordingError.empty()) {
+      showError(live_->recordingError);
+      status_ = live_->recordingError;
+      live_->recordingError.clear();
+      recordingFailed_ = true;
+    }
     if (!r.ok) {
       *error = "the simulation faulted: " + r.error.message();
       return false;

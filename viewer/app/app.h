@@ -149,6 +149,7 @@ class App {
   int64_t scrubTick_ = 0;   ///< where it is held
   std::string errorText_;   ///< the error window's line ("" when closed)
   std::string status_;
+  bool recordingFailed_ = false;  ///< a recording stopped on a write error (exit code 1 at the end)
   // Stats.
   double renderMs_ = 0, frameMs_ = 0;
   std::array<double, size_t(Stage::Count)> stageMs_{};

@@ -57,7 +57,20 @@ std::unique_ptr<Session> Session::rebuilt(const std::string& text, bool replayHi
 
 StepResult Session::step(const TickInput& input) {
   history.push_back(input);
-  return recorder ? recorder->step(input, &clock) : world->step(input, &clock);
+  if (!recorder) return world->step(input, &clock);
+  const int64_t before = world->tick();
+  try {
+    return recorder->step(input, &clock);
+  } catch (const std::exception& e) {
+    // A write that failed (a full disk, a file-size limit): the recording ends at its last
+    // complete chunk (still readable, as a recording cut off by a crash) and the session goes on
+    // unrecorded; the caller shows recordingError. The writer appends the tick's input before
+    // stepping and writes after it, so the world has stepped unless the step itself failed.
+    recordingError = std::string(e.what()) + " (the recording stopped there, the session goes on)";
+    recorder.reset();
+    if (world->tick() == before) return world->step(input, &clock);
+    return {};
+  }
 }
 
 bool Session::startRecording(const std::string& path, std::string* error) {

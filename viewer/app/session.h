@@ -35,7 +35,10 @@ class Session {
   /// ScenarioError naming the tick.
   std::unique_ptr<Session> rebuilt(const std::string& text, bool replayHistory) const;
 
+  /// One tick (recorded when recording). A recording write that fails stops the recording, sets
+  /// recordingError (one line) and the session goes on.
   StepResult step(const TickInput& input);
+  std::string recordingError;  ///< set by step() when the recording stopped on a write error
 
   /// Records the whole session, from tick 0, to `path`: a fresh world replays the inputs so far
   /// under a Recorder (a recording must start from a state a replay can build), must reach the
