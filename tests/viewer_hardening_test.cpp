@@ -121,6 +121,8 @@ TEST(ViewerHardening, SetValuesThatAreTooDeepTooLongOrTooFarAreShortOneLineError
       {"set " + deepPath + " 1", "a path of at most 256 characters"},
       // Echoed input: control characters escaped, truncated.
       {"set field.patchesX \x01" + std::string(5000, 'x'), "a JSON value, got '\\x01xxx"},
+      // A name that is not UTF-8 would make the regenerate's dump throw out of the frame loop.
+      {"set field.\xff 1\nregenerate", "a path of UTF-8 names"},
   };
   for (const Case& c : cases) {
     const std::string script = dir.write("set.txt", c.line + "\nquit\n");

@@ -119,7 +119,7 @@ int App::runCommand(const ScriptCommand& c) {
       return kGoOn;
     case K::Regenerate: {
       std::string text = live_->scenario.text;
-      if (stagedJson_) text = stagedJson_->dump(2);
+      if (stagedJson_) text = stagedJson_->dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
       stagedJson_.reset();
       if (text.size() > InputLimits::kScenarioBytes) {  // what a scenario file may hold
         showError(live_->scenario.sourceName + ": $: expected an edited scenario of at most " +

@@ -138,6 +138,11 @@ void editScenarioJson(nlohmann::json* doc, const std::string& sourceName, const 
     const size_t dot = dotted.find('.', at);
     segments.push_back(dotted.substr(at, dot == std::string::npos ? std::string::npos : dot - at));
     if (segments.back().empty()) throw ScenarioError(sourceName, where, "a dotted path of names (a.b.c)");
+    try {  // a name that is not UTF-8 would make every later dump of the scenario throw
+      (void)nlohmann::json(segments.back()).dump();
+    } catch (const nlohmann::json::exception&) {
+      throw ScenarioError(sourceName, where, "a path of UTF-8 names");
+    }
     if (dot == std::string::npos) break;
     at = dot + 1;
   }
