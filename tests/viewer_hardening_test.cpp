@@ -71,6 +71,21 @@ TEST(ViewerHardening, ScriptThatIsAFifoFolderDeviceOrTooLargeIsOneLine) {
   }
 }
 
+TEST(ViewerHardening, InputThatIsAFifoOrFolderIsOneLine) {
+  TempDir dir;
+  for (const std::string& input : {fifo(dir, "in.json"), fifo(dir, "in.sgr"), dir.file("")}) {
+    const CliResult r = runViewer(quote(input), false);  // before any window: no display needed
+    EXPECT_EQ(r.exitCode, 2) << input << "\n" << r.describe();
+    EXPECT_TRUE(isOneLine(r.err)) << r.err;
+    EXPECT_NE(r.err.find("expected a regular file, got a"), std::string::npos) << r.err;
+  }
+  // The A/B recording too.
+  const std::string rec = test::sourcePath("scenarios/recordings/thesis-bodies-fx32.sgr");
+  const CliResult ab = runViewer(quote(rec) + " --ab " + quote(fifo(dir, "b.sgr")), false);
+  EXPECT_EQ(ab.exitCode, 2) << ab.describe();
+  EXPECT_NE(ab.err.find("b.sgr: byte 0: expected a regular file, got a FIFO"), std::string::npos) << ab.err;
+}
+
 TEST(ViewerHardening, WindowSizeTimesSamplesIsBounded) {
   const CliResult r = runViewer("--size 8192x8192 --msaa 8", false);
   EXPECT_EQ(r.exitCode, 2) << r.describe();
@@ -210,6 +225,26 @@ TEST(ViewerHardening, StepsAndSeeksStopAtTheRecordingsLastTick) {
   EXPECT_EQ(at[0].first, at[0].second) << "step stops at the last tick";
   EXPECT_EQ(at[1].first, 3);
   EXPECT_EQ(v.err, "") << v.describe();
+}
+
+TEST(ViewerHardening, ASeekThroughADamagedSnapshotShowsTheCliLineAndStaysPut) {
+  if (!onPath("xvfb-run")) GTEST_SKIP() << "xvfb-run is not on PATH";
+  TempDir dir;
+  // Its first snapshot (tick 8) is damaged behind a valid checksum: only decompressing it (a
+  // seek, or --verify) finds out.
+  const std::string rec = test::sourcePath("tests/data/sgr/damaged/snap-zstd-magic.sgr");
+  const CliResult cli = runCli("replay " + quote(rec) + " --verify");
+  ASSERT_EQ(cli.exitCode, 2) << cli.describe();
+  const std::string message = cli.err.substr(std::string("simgrass replay: ").size());
+  const std::string script = dir.write("s.txt", "seek 10\nprint\nstatus\nseek 24\nprint\nquit\n");
+  const CliResult v = runViewer(quote(rec) + " --script " + quote(script) + kWindow);
+  ASSERT_EQ(v.exitCode, 0) << v.describe();
+  EXPECT_EQ(v.err, "simgrass-viewer: " + message);
+  const std::vector<std::string> shown = errorLines(v.out);
+  ASSERT_EQ(shown.size(), 1u) << v.describe();
+  EXPECT_EQ(shown[0] + "\n", message);
+  EXPECT_NE(v.out.find("playback 0/24"), std::string::npos) << "the failed seek stays where it was: " << v.out;
+  EXPECT_NE(v.out.find("playback 24/24"), std::string::npos) << "the next seek works: " << v.out;
 }
 
 // ---- simgrass render ------------------------------------------------------------------------
