@@ -97,17 +97,23 @@ TEST(ViewerHardening, OpeningBadFilesShowsTheOneLineErrorInTheWindowAndGoesOn) {
   if (!onPath("xvfb-run")) GTEST_SKIP() << "xvfb-run is not on PATH";
   TempDir dir;
   const std::string scenarioFifo = fifo(dir, "s.json"), recordingFifo = fifo(dir, "r.sgr");
+  // A sparse file one byte over the heightmap limit (64 MiB): refused before it is read.
+  const std::string bigHeightmap = dir.write("big.png", "");
+  fs::resize_file(bigHeightmap, (uintmax_t(64) << 20) + 1);
   const std::string script =
       dir.write("open.txt", "frames 1\nopen " + scenarioFifo + "\nstatus\nopen " + dir.file("") + "\nstatus\nopen " +
                                 recordingFifo + "\nstatus\nopen " + dir.file("missing.json") +
                                 "\nstatus\nset field.spacing -1\nregenerate\nstatus\n"
+                                "set terrain {\"type\": \"heightmap\", \"file\": \"" +
+                                bigHeightmap +
+                                "\", \"cellSize\": 1, \"maxHeight\": 5}\nregenerate\nstatus\n"
                                 "frames 1\nprint\nquit\n");
   const CliResult v = runViewer("--script " + quote(script) + kWindow);
   ASSERT_EQ(v.exitCode, 0) << v.describe();
   // Each error: one line on stderr, and the same line in the window's error area.
   const std::vector<std::string> err = linesOf(v.err), shown = errorLines(v.out);
-  ASSERT_EQ(err.size(), 5u) << v.describe();
-  ASSERT_EQ(shown.size(), 5u) << v.describe();
+  ASSERT_EQ(err.size(), 6u) << v.describe();
+  ASSERT_EQ(shown.size(), 6u) << v.describe();
   for (size_t i = 0; i < err.size(); ++i) EXPECT_EQ(err[i], "simgrass-viewer: " + shown[i]);
   EXPECT_NE(shown[0].find(scenarioFifo), std::string::npos) << shown[0];
   EXPECT_NE(shown[0].find("FIFO"), std::string::npos) << shown[0];
@@ -116,6 +122,7 @@ TEST(ViewerHardening, OpeningBadFilesShowsTheOneLineErrorInTheWindowAndGoesOn) {
   EXPECT_NE(shown[2].find("FIFO"), std::string::npos) << shown[2];
   EXPECT_NE(shown[3].find("not found"), std::string::npos) << shown[3];
   EXPECT_NE(shown[4].find("$.field.spacing"), std::string::npos) << shown[4];
+  EXPECT_NE(shown[5].find("a file of at most 67108864 bytes"), std::string::npos) << shown[5];
   // The session went on: the built-in meadow, two frames.
   EXPECT_NE(v.out.find("state      tick 2,"), std::string::npos) << v.out;
 }
