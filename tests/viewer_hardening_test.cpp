@@ -266,6 +266,25 @@ TEST(ViewerHardening, ASeekThroughADamagedSnapshotShowsTheCliLineAndStaysPut) {
   EXPECT_NE(v.out.find("playback 24/24"), std::string::npos) << "the next seek works: " << v.out;
 }
 
+TEST(ViewerHardening, ADamagedSnapshotOfTheBSideIsTheOneLineErrorNotACrash) {
+  if (!onPath("xvfb-run")) GTEST_SKIP() << "xvfb-run is not on PATH";
+  TempDir dir;
+  // B is A (tiny.sgr) with its first snapshot damaged behind a valid checksum: seeking back to
+  // tick 10 rewinds B through it.
+  const std::string a = test::sourcePath("tests/data/sgr/tiny.sgr");
+  const std::string b = test::sourcePath("tests/data/sgr/damaged/snap-zstd-magic.sgr");
+  const std::string script = dir.write("ab.txt", "seek 24\nprint\nseek 10\nprint\nstatus\nquit\n");
+  const CliResult v = runViewer(quote(a) + " --ab " + quote(b) + " --script " + quote(script) + kWindow);
+  ASSERT_EQ(v.exitCode, 0) << v.describe();
+  EXPECT_TRUE(isOneLine(v.err)) << v.err;
+  EXPECT_NE(v.err.find(b + ": byte 1165: expected a zstd frame"), std::string::npos) << v.err;
+  const std::vector<std::string> shown = errorLines(v.out);
+  ASSERT_EQ(shown.size(), 1u) << v.describe();
+  EXPECT_EQ("simgrass-viewer: " + shown[0] + "\n", v.err);
+  EXPECT_NE(v.out.find("playback 10/24"), std::string::npos) << "A went on: " << v.out;
+  EXPECT_NE(v.out.find("tipMax -1 m"), std::string::npos) << "B is not measured: " << v.out;
+}
+
 // ---- simgrass render ------------------------------------------------------------------------
 
 TEST(RenderHardening, FrameSamplesAndContactSheetsAreBounded) {

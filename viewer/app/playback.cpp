@@ -82,22 +82,37 @@ void Playback::buildB() {
   syncB();
 }
 
-/// Brings B to A's tick (or the last common tick before it) and measures the divergence there.
-void Playback::syncB() {
-  if (!b_) return;
-  const int64_t t = tick();
+/// B's target for A's tick: the last common tick at or before it (B may end earlier).
+int64_t Playback::commonTickB() const {
   const int64_t m = b_->mergedTicks();
-  int64_t target = t / m * m;
-  target = std::min(target, (recB_ ? recB_->lastTick() : rec_->lastTick()) / m * m);
-  if (target < b_->recordedTick()) {
-    if (m == 1 && b_->substeps() == 1) {
-      const StepResult r = b_->player().seek(target);
-      if (!r.ok) return;
-    } else {
-      b_ = std::make_unique<LockStepReplay>(recB_ ? *recB_ : *rec_, threads_, variantB_);
+  return std::min(tick() / m * m, (recB_ ? recB_->lastTick() : rec_->lastTick()) / m * m);
+}
+
+/// Moves B back when it is past `target`: to its nearest snapshot (or its start) at or before
+/// it, restoring only (the steps from there are syncB's or work()'s). False, B unmeasured, when
+/// B's snapshot is damaged or the restore fails.
+bool Playback::rewindB(int64_t target, std::string* why) {
+  if (target >= b_->recordedTick()) return true;
+  try {
+    if (b_->mergedTicks() == 1 && b_->substeps() == 1) {
+      const sgr::Recording& r = recB_ ? *recB_ : *rec_;
+      const sgr::SnapshotInfo* snap = b_->player().sameSettingsAsRecorded() ? r.snapshotAtOrBefore(target) : nullptr;
+      const StepResult step = b_->player().seek(snap ? snap->tick : r.header.startTick);
+      if (!step.ok && why) *why = labelB_ + ": " + step.error.message();
+      return step.ok;
     }
+    b_ = std::make_unique<LockStepReplay>(recB_ ? *recB_ : *rec_, threads_, variantB_);
+    return true;
+  } catch (const std::exception& e) {  // sgr::RecordingError: a damaged snapshot of B
+    if (why) *why = e.what();
+    return false;
   }
-  if (!b_->advanceTo(target).ok || b_->recordedTick() != t) {
+}
+
+/// Measures A against B (B at A's tick; else B stays unmeasured).
+void Playback::measureB() {
+  const int64_t t = tick();
+  if (b_->recordedTick() != t) {
     measured_ = false;
     return;
   }
@@ -106,6 +121,24 @@ void Playback::syncB() {
   last_ = measureDivergence(obsA_, obsB_, player_->world().stateHash() == b_->world().stateHash());
   measured_ = true;
   if (last_.observedDifference() && (firstDivergent_ < 0 || t < firstDivergent_)) firstDivergent_ = t;
+}
+
+/// Brings B to A's tick (or the last common tick before it) and measures the divergence there,
+/// at once: for single steps, where B is at most one step behind.
+void Playback::syncB() {
+  if (!b_) return;
+  const int64_t target = commonTickB();
+  measured_ = false;
+  if (!rewindB(target, nullptr) || !b_->advanceTo(target).ok) return;
+  measureB();
+}
+
+/// After a seek of A: B rewinds now and catches up in work()'s slices (a variant B has no
+/// snapshots and replays from its start). False with *why when B cannot rewind (B unmeasured).
+bool Playback::beginCatchUpB(std::string* why) {
+  measured_ = false;
+  catchingUpB_ = b_ && rewindB(commonTickB(), why);
+  return !b_ || catchingUpB_;
 }
 
 void Playback::checkHash() {
@@ -155,7 +188,7 @@ bool Playback::advance(double wallTicks, std::string* error) {
 bool Playback::seek(int64_t t, std::string* error) {
   t = std::clamp<int64_t>(t, rec_->header.startTick, lastTick());
   accumulator_ = 0;
-  target_ = -1;
+  cancel();
   // The jump now (what Player::seek does first): the nearest snapshot at or before t, or the
   // start, unless stepping on from here is shorter. Player::seek to that tick restores it and
   // steps nothing; the steps from there to t are work()'s.
@@ -176,8 +209,7 @@ bool Playback::seek(int64_t t, std::string* error) {
   }
   if (tick() == t) {
     checkHash();
-    syncB();
-    return true;
+    return beginCatchUpB(error) && work(0, error);
   }
   target_ = t;
   checkEachTick_ = false;
@@ -185,32 +217,46 @@ bool Playback::seek(int64_t t, std::string* error) {
 }
 
 bool Playback::work(double seconds, std::string* error) {
-  if (!busy()) return true;
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  do {
-    if (tick() >= target_) break;
-    StepResult r;
-    try {
-      r = player_->stepForward();
-    } catch (const sgr::RecordingError& e) {
+  while (busy()) {
+    if (target_ >= 0 && tick() < target_) {
+      StepResult r;
+      std::string why;
+      try {
+        r = player_->stepForward();
+      } catch (const sgr::RecordingError& e) {
+        r.ok = false;
+        why = e.what();
+      }
+      if (!r.ok) {
+        *error = why.empty() ? r.error.message() : why;
+        cancel();
+        playing = false;
+        return false;
+      }
+      if (checkEachTick_) {
+        checkHash();
+        syncB();
+      }
+    }
+    if (target_ >= 0 && tick() >= target_) {
       target_ = -1;
-      playing = false;
-      *error = e.what();
-      return false;
+      if (!checkEachTick_) {
+        checkHash();
+        if (!beginCatchUpB(error)) return false;
+      }
+    } else if (target_ < 0 && catchingUpB_) {
+      // B, one of its steps at a time (m recorded ticks), up to A's tick.
+      const int64_t bt = commonTickB();
+      if (b_->recordedTick() < bt && !b_->advanceTo(b_->recordedTick() + b_->mergedTicks()).ok) catchingUpB_ = false;
+      if (catchingUpB_ && b_->recordedTick() >= bt) {
+        catchingUpB_ = false;
+        measureB();
+      }
     }
-    if (!r.ok) {
-      target_ = -1;
-      playing = false;
-      *error = r.error.message();
-      return false;
-    }
-    if (checkEachTick_ || tick() >= target_) {
-      checkHash();
-      syncB();
-    }
-  } while (std::chrono::duration<double>(Clock::now() - start).count() < seconds);
-  if (tick() >= target_) target_ = -1;
+    if (std::chrono::duration<double>(Clock::now() - start).count() >= seconds) break;
+  }
   return true;
 }
 

@@ -52,11 +52,16 @@ class Playback {
   /// Starts moving to tick t (clamped to the recording, so never past lastTick()): the nearest
   /// snapshot is restored at once, the ticks from there to t run in work().
   bool seek(int64_t t, std::string* error);
-  /// A seek or step is under way (target() is where it goes).
-  bool busy() const { return target_ >= 0; }
-  int64_t target() const { return target_; }
-  /// Stops a pending seek or step where it stands (a consistent state: a whole tick).
-  void cancel() { target_ = -1; }
+  /// A seek or step is under way, or B catching up with A after a seek (target() is where A goes).
+  bool busy() const { return target_ >= 0 || catchingUpB_; }
+  int64_t target() const { return target_ >= 0 ? target_ : tick(); }
+  /// Stops a pending seek or step where it stands (a consistent state: a whole tick); B stays
+  /// unmeasured until the next step or seek.
+  void cancel() {
+    target_ = -1;
+    if (catchingUpB_) measured_ = false;
+    catchingUpB_ = false;
+  }
   /// Runs a pending seek or step for about `seconds` of wall time (at least one tick). Returns
   /// false with *error (one line) on a fault or a damaged snapshot; the pending move then stops.
   bool work(double seconds, std::string* error);
@@ -87,6 +92,10 @@ class Playback {
   void checkHash();
   void buildB();
   void syncB();
+  int64_t commonTickB() const;
+  bool rewindB(int64_t target, std::string* why);
+  void measureB();
+  bool beginCatchUpB(std::string* why);
   std::unique_ptr<sgr::Recording> rec_, recB_;
   std::unique_ptr<Player> player_;
   RecordedHashes* hashes_ = nullptr;
@@ -94,6 +103,7 @@ class Playback {
   int threads_ = 1;
   double accumulator_ = 0;      ///< recorded ticks not yet run
   int64_t target_ = -1;         ///< where a pending seek or step goes (-1: none)
+  bool catchingUpB_ = false;    ///< after a seek: B steps towards A's tick in work()'s slices
   bool checkEachTick_ = false;  ///< step: every tick's hash checked and B synced; seek: only the last
   std::set<int64_t> okTicks_;
   int64_t firstMismatch_ = -1;
