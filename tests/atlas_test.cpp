@@ -3,6 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <stb/stb_image.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
 
 #include <algorithm>
 #include <cmath>
@@ -340,6 +345,32 @@ TEST(AtlasPng, MissingDirectoryFailsWithThePath) {
   EXPECT_FALSE(writePng(path, makeGroundTexture(defaultAtlas(), 1, 16), &error));
   EXPECT_NE(error.find(path), std::string::npos) << error;
   EXPECT_FALSE(writePng(path, Image{}, &error));
+}
+
+TEST(AtlasPng, AFullDiskIsAnErrorAndLeavesNoFileBehind) {
+  // A child process with RLIMIT_FSIZE of 4 KiB (SIGXFSZ ignored, so writes fail with EFBIG, as
+  // on a full disk): writePng must say so and leave neither the PNG nor a temporary file.
+  const std::filesystem::path dir = std::filesystem::path(testing::TempDir()) / "simgrass-atlas-full-disk";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "atlas.png").string();
+  const Image image = makeRockTexture(7, 256);  // noisy: far more than 4 KiB compressed
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{4096, 4096};
+    setrlimit(RLIMIT_FSIZE, &limit);
+    std::string error;
+    const bool written = writePng(path, image, &error);
+    _exit(written ? 10 : error.find(path) == std::string::npos ? 11 : 0);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status)) << status;
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "10: the write was reported as done; 11: the error does not name the file";
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) ADD_FAILURE() << "left behind: " << entry.path();
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

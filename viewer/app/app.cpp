@@ -8,11 +8,13 @@
 #include <link.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
 
+#include "replay/input_file.h"
 #include "viewer/app/text.h"
 
 // Sanitizer builds: the GL driver (Mesa's GLX and llvmpipe, LLVM) and libX11 keep allocations
@@ -123,6 +125,7 @@ void App::close() {
 }
 
 int App::finish(int code) {
+  if (recordingFailed_ && code == kExitOk) code = kExitFailure;  // a recording lost ticks: not a clean run
   if (live_->recorder) {
     std::string e;
     if (!live_->stopRecording(&e) && code == kExitOk) {
@@ -214,7 +217,14 @@ void App::handleToggles() {
   std::string error;
   if (pressed(GLFW_KEY_C)) cam_.free = !cam_.free;
   if (pressed(GLFW_KEY_V) && play_ && play_->hasB()) abView_ = abView_ == AbView::Side ? AbView::Overlay : AbView::Side;
-  if (!scripted_ && pressed(GLFW_KEY_ESCAPE)) glfwSetWindowShouldClose(window_, GLFW_TRUE);
+  if (!scripted_ && pressed(GLFW_KEY_ESCAPE)) {
+    if (play_ && play_->busy()) {  // Escape first cancels a pending seek, then quits
+      play_->cancel();
+      status_ = "seek cancelled at tick " + std::to_string(play_->tick());
+    } else {
+      glfwSetWindowShouldClose(window_, GLFW_TRUE);
+    }
+  }
   if (play_) {
     if (pressed(GLFW_KEY_SPACE)) play_->playing = !play_->playing;
     if (pressed(GLFW_KEY_PERIOD)) {
@@ -238,8 +248,13 @@ void App::handleToggles() {
     if (live_->recorder) {
       status_ = live_->stopRecording(&error) ? "saved " + live_->recordPath : error;
     } else {
+      // The scenario's name comes from its JSON: only letters, digits, '-' and '_' of it, at most
+      // 40, go into the file name (a name like "../../x" must not pick the folder).
+      std::string name;
+      for (char ch : live_->scenario.name)
+        if (name.size() < 40 && (std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_')) name += ch;
       const std::string path =
-          "simgrass-" + live_->scenario.name + "-" +
+          "simgrass-" + (name.empty() ? std::string("session") : name) + "-" +
           std::to_string(std::chrono::system_clock::now().time_since_epoch().count() / 1000000000) + ".sgr";
       status_ = live_->startRecording(path, &error) ? "" : error;
     }
@@ -252,6 +267,16 @@ bool App::simulate(double wall, std::string* error) {
   if (play_) {
     // Playback: `wall` seconds are wall/dt recorded ticks at speed 1 (a scripted frame: one).
     const double dt = play_->scenario().timeStep.toDouble();
+    if (play_->busy()) {
+      // A pending seek or step: a slice of it per frame, so the window stays responsive and
+      // Escape (or the panel's Cancel) can stop it. A failure is the one-line error, shown.
+      std::string e;
+      if (!play_->work(scripted_ ? kScriptedSeekSeconds : kSeekSecondsPerFrame, &e)) showError(e);
+      status_ = play_->busy()
+                    ? "seeking to tick " + std::to_string(play_->target()) + ": at " + std::to_string(play_->tick())
+                    : "at tick " + std::to_string(play_->tick());
+      return true;
+    }
     if (!play_->advance(scripted_ ? 1.0 : std::min(wall, 0.25) / dt, error)) return false;
     if (!play_->mismatchText().empty() && errorText_.empty()) errorText_ = play_->mismatchText();
     return true;
@@ -268,6 +293,12 @@ bool App::simulate(double wall, std::string* error) {
     // The tick before the last of this frame is what display interpolation starts from.
     if (i + 1 == steps && interpolate_ && !scripted_) extractScene(world(), scenario(), &previous_);
     const StepResult r = live_->step(tickInput());
+    if (!live_->recordingError.empty()) {
+      showError(live_->recordingError);
+      status_ = live_->recordingError;
+      live_->recordingError.clear();
+      recordingFailed_ = true;
+    }
     if (!r.ok) {
       *error = "the simulation faulted: " + r.error.message();
       return false;
@@ -334,7 +365,19 @@ void App::renderWorld(int fbw, int fbh) {
   glViewport(0, 0, fbw, fbh);
 }
 
+std::string App::inputNamed(const std::string& path) const {
+  std::vector<std::string> inputs = {opt_.script, opt_.input, opt_.abFile, live_->scenario.sourceName};
+  if (play_) inputs.push_back(play_->recording().file);
+  for (const std::string& in : inputs)
+    if (!in.empty() && sameFile(path, in)) return in;
+  return {};
+}
+
 bool App::screenshot(const std::string& path, std::string* error) {
+  if (const std::string in = inputNamed(path); !in.empty()) {
+    *error = path + ": expected an output file other than the input " + in;
+    return false;
+  }
   int fbw = 0, fbh = 0;
   glfwGetFramebufferSize(window_, &fbw, &fbh);
   renderWorld(fbw, fbh);
@@ -371,6 +414,12 @@ int App::run(const std::vector<ScriptCommand>* script, const std::string& startu
   cam_.eyeHeight = cam_.camera.y - groundHeight(world(), cam_.camera.x, cam_.camera.z);
   render_.alphaToCoverage = samples_ > 0;
   if (play_) play_->playing = !scripted_;  // interactive: starts playing; scripts start paused
+  if (!opt_.record.empty() && !inputNamed(opt_.record).empty()) {
+    std::fprintf(stderr, "simgrass-viewer: --record: %s: expected an output file other than the input %s\n",
+                 opt_.record.c_str(), inputNamed(opt_.record).c_str());
+    close();
+    return kExitBadInput;
+  }
   if (!opt_.record.empty() && !live_->startRecording(opt_.record, &error)) {
     std::fprintf(stderr, "simgrass-viewer: %s\n", error.c_str());
     return finish(kExitFailure);

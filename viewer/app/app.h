@@ -15,6 +15,8 @@
 
 #include <array>
 #include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +32,10 @@ namespace sg::viewer {
 
 /// App::runScript / runCommand: go on (any other value is an exit code).
 inline constexpr int kGoOn = -1;
+
+/// Wall time a pending seek or step may take per frame (interactive; scripted runs wait for it
+/// with bigger slices). A seek's length is bounded by the recording's last tick.
+inline constexpr double kSeekSecondsPerFrame = 0.03, kScriptedSeekSeconds = 0.25;
 
 /// Panel edit buffers (what the Physics, Grass, Meadow and Terrain panels show before Apply).
 struct ScenarioEdits {
@@ -73,7 +79,11 @@ class App {
   void buildScenes(float alpha);
   void renderWorld(int fbw, int fbh);
   bool screenshot(const std::string& path, std::string* error);
+  /// The input of this session (script, scenario, recording, A/B file) that `path` names (same
+  /// file), or "": outputs never replace an input.
+  std::string inputNamed(const std::string& path) const;
   void printState() const;
+  void printStatus() const;
   std::function<float(float, float)> ground();
 
   // ---- files and sessions (app_files.cpp) ----
@@ -139,15 +149,16 @@ class App {
   int64_t scrubTick_ = 0;   ///< where it is held
   std::string errorText_;   ///< the error window's line ("" when closed)
   std::string status_;
+  bool recordingFailed_ = false;  ///< a recording stopped on a write error (exit code 1 at the end)
   // Stats.
   double renderMs_ = 0, frameMs_ = 0;
   std::array<double, size_t(Stage::Count)> stageMs_{};
   double simMsPerTick_ = 0;
   int64_t clockTicks_ = 0;
   int64_t frames_ = 0;
-  std::string scriptWhere_;  ///< "FILE:LINE: " of the running script command
-  size_t scriptNext_ = 0;    ///< next script command
-  std::string stagedText_;   ///< scenario text edited by `set`, applied by `regenerate`
+  std::string scriptWhere_;                   ///< "FILE:LINE: " of the running script command
+  size_t scriptNext_ = 0;                     ///< next script command
+  std::optional<nlohmann::json> stagedJson_;  ///< scenario edited by `set`, applied by `regenerate`
 };
 
 }  // namespace sg::viewer

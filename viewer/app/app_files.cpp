@@ -37,6 +37,7 @@ bool App::openFile(const std::string& path) {
   pendingCommands_.clear();
   accumulator_ = 0;
   errorText_.clear();
+  stagedJson_.reset();  // `set` edits staged for the previous scenario
   resetEdits();
   extractScene(world(), scenario(), &scene_);
   cam_.camera = defaultCamera(scene_, world());
@@ -101,7 +102,9 @@ std::string App::editedScenarioText() const {
                     {"file", std::string(edits_.heightmap)},
                     {"cellSize", round6(edits_.cellSize)},
                     {"maxHeight", round6(edits_.maxHeight)}};
-  return j.dump(2);
+  // A heightmap name typed in the panel that is not UTF-8 becomes U+FFFD (a file-not-found line
+  // later), never an exception out of the frame loop.
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 bool App::applyScenario(const std::string& text, bool replayHistory, const std::string& what) {

@@ -3,6 +3,7 @@
 #include <cinttypes>
 #include <cstdio>
 
+#include "replay/input_file.h"
 #include "viewer/app/app.h"
 #include "viewer/app/text.h"
 
@@ -22,6 +23,14 @@ void App::printState() const {
                   play_->measured() ? play_->divergence().tipRms : -1.0, play_->firstDivergentTick());
   }
   std::printf("\n");
+  std::fflush(stdout);
+}
+
+/// The `status` lines: the status line and the error window's text, as the window shows them
+/// (tests check that a bad file or edit reaches the UI, not only stderr).
+void App::printStatus() const {
+  std::printf("status     %s\n", status_.empty() ? "-" : status_.c_str());
+  std::printf("error      %s\n", errorText_.empty() ? "-" : errorText_.c_str());
   std::fflush(stdout);
 }
 
@@ -56,12 +65,16 @@ int App::runCommand(const ScriptCommand& c) {
       return kGoOn;
     case K::RecordStart:
       if (play_) return bad("record start: a playback is not recorded again");
+      if (const std::string in = inputNamed(c.path); !in.empty())
+        return bad(c.path + ": expected an output file other than the input " + in);
       if (!live_->startRecording(c.path, &error)) return failWith(kExitFailure, error);
       return kGoOn;
     case K::RecordStop:
       if (!live_->stopRecording(&error)) return failWith(kExitFailure, error);
       return kGoOn;
     case K::Screenshot:
+      if (const std::string in = inputNamed(c.path); !in.empty())
+        return bad(c.path + ": expected an output file other than the input " + in);
       if (!screenshot(c.path, &error)) return failWith(kExitFailure, error);
       return kGoOn;
     case K::Quit:
@@ -96,16 +109,23 @@ int App::runCommand(const ScriptCommand& c) {
       return kGoOn;  // a bad file: the error shown, the session goes on
     case K::Set:
       try {
-        // Staged like a panel edit: the next `regenerate` builds the world from it.
-        stagedText_ = editScenarioText(stagedText_.empty() ? live_->scenario.text : stagedText_,
-                                       live_->scenario.sourceName, c.path, c.value);
+        // Staged like a panel edit: the next `regenerate` builds the world from it. Staged as
+        // parsed JSON, so a script of many `set` lines costs one parse and one dump.
+        if (!stagedJson_) stagedJson_ = parseScenarioJsonForEdit(live_->scenario.text, live_->scenario.sourceName);
+        editScenarioJson(&*stagedJson_, live_->scenario.sourceName, c.path, c.value);
       } catch (const std::exception& e) {
         return bad(e.what());
       }
       return kGoOn;
     case K::Regenerate: {
-      const std::string text = stagedText_.empty() ? live_->scenario.text : stagedText_;
-      stagedText_.clear();
+      std::string text = live_->scenario.text;
+      if (stagedJson_) text = stagedJson_->dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+      stagedJson_.reset();
+      if (text.size() > InputLimits::kScenarioBytes) {  // what a scenario file may hold
+        showError(live_->scenario.sourceName + ": $: expected an edited scenario of at most " +
+                  std::to_string(InputLimits::kScenarioBytes) + " bytes, got " + std::to_string(text.size()));
+        return kGoOn;
+      }
       applyScenario(text, false, "regenerated");  // a bad edit: the error shown, the session goes on
       return kGoOn;
     }
@@ -123,12 +143,21 @@ int App::runCommand(const ScriptCommand& c) {
     case K::Print:
       printState();
       return kGoOn;
+    case K::Status:
+      printStatus();
+      return kGoOn;
   }
   return kGoOn;
 }
 
 int App::runScript(const std::vector<ScriptCommand>& script, int64_t* frames) {
   while (true) {
+    // A seek or step under way runs frame by frame (App::simulate); the script waits for it, so
+    // the next command sees the tick it asked for.
+    if (play_ && play_->busy()) {
+      *frames = 0;
+      return kGoOn;
+    }
     if (scriptNext_ >= script.size()) return kExitOk;  // the end of the script quits
     const ScriptCommand& c = script[scriptNext_++];
     scriptWhere_ = opt_.script + ":" + std::to_string(c.line) + ": ";

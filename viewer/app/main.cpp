@@ -2,9 +2,8 @@
 // reads the script, opens the input (a scenario, or a recording to play back, optionally A/B)
 // and hands everything to App (app.h), which owns the window and the frame loop.
 #include <cstdio>
-#include <fstream>
-#include <sstream>
 
+#include "replay/input_file.h"
 #include "replay/kernel_environment.h"
 #include "viewer/app/app.h"
 
@@ -19,15 +18,14 @@ int main(int argc, char** argv) {
   if (const int code = parseOptions(argc, argv, &o); code >= 0) return code;
   std::vector<ScriptCommand> script;
   if (!o.script.empty()) {
-    std::ifstream in(o.script, std::ios::binary);
-    if (!in) {
-      std::fprintf(stderr, "simgrass-viewer: %s: cannot read the script\n", o.script.c_str());
+    // The bounded reader: a FIFO or /dev/zero is refused at once, a huge file before any read.
+    std::string text, expected;
+    if (!readInputFile(o.script, InputLimits::kScriptBytes, &text, &expected)) {
+      std::fprintf(stderr, "simgrass-viewer: %s: expected %s\n", o.script.c_str(), expected.c_str());
       return kExitBadInput;
     }
-    std::stringstream text;
-    text << in.rdbuf();
     std::string error;
-    if (!parseScript(text.str(), o.script, &script, &error)) {
+    if (!parseScript(text, o.script, &script, &error)) {
       std::fprintf(stderr, "simgrass-viewer: %s\n", error.c_str());
       return kExitBadInput;
     }

@@ -1,6 +1,9 @@
 #include "viewer/app/options.h"
 
+#include "viewer/app/text.h"
+
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 
@@ -49,7 +52,15 @@ int parseOptions(int argc, char** argv, Options* o) {
   }
   if (!parseSize(o->size, &o->width, &o->height)) {
     std::fprintf(stderr, "simgrass-viewer: --size: expected WxH with both from 64 to 8192, got '%s'\n",
-                 o->size.c_str());
+                 shownText(o->size).c_str());
+    return kExitBadInput;
+  }
+  // The window's framebuffer: width x height x samples, bounded like `simgrass render`'s frames.
+  const int64_t samples = int64_t(o->width) * int64_t(o->height) * std::max(1, o->msaa);
+  if (samples > kMaxWindowSamples) {
+    std::fprintf(stderr,
+                 "simgrass-viewer: --size, --msaa: expected at most %lld samples (width x height x msaa), got %lld\n",
+                 static_cast<long long>(kMaxWindowSamples), static_cast<long long>(samples));
     return kExitBadInput;
   }
   if (!o->abFile.empty() && !o->abVariant.empty()) {

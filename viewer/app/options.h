@@ -9,6 +9,10 @@ namespace sg::viewer {
 
 inline constexpr int kExitOk = 0, kExitFailure = 1, kExitBadInput = 2;
 
+/// Samples the window's framebuffer may have (width x height x max(1, msaa)): 8192x8192 without
+/// MSAA, 4096x4096 at 4x (docs/viewer.md "Limits").
+inline constexpr int64_t kMaxWindowSamples = int64_t(1) << 26;
+
 struct Options {
   std::string input;  ///< scenario JSON or recording (.sgr); empty: the built-in thesis meadow
   std::string script, record, size = "1280x720";

@@ -63,6 +63,11 @@ void App::panelPlayback() {
   std::string error;
   ImGui::Text("%s", play_->recording().file.c_str());
   ImGui::Text("tick %" PRId64 " / %" PRId64, play_->tick(), play_->lastTick());
+  if (play_->busy()) {
+    ImGui::Text("seeking to tick %" PRId64 "...", play_->target());
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel (Esc)")) play_->cancel();
+  }
   if (ImGui::Button(play_->playing ? "Pause (Space)" : "Play (Space)")) play_->playing = !play_->playing;
   ImGui::SameLine();
   if (ImGui::Button("Step (.)")) {

@@ -1,28 +1,42 @@
 #include "viewer/app/playback.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <stdexcept>
 
+#include "replay/format/sgr_reader.h"
+#include "replay/input_file.h"
 #include "viewer/app/text.h"
 
 namespace sg::viewer {
 
 bool looksLikeRecording(const std::string& path) {
   if (path.size() >= 4 && path.compare(path.size() - 4, 4, ".sgr") == 0) return true;
-  std::ifstream in(path, std::ios::binary);
-  char magic[sizeof sgr::kMagic] = {};
-  return in.read(magic, sizeof magic) && std::memcmp(magic, sgr::kMagic, sizeof magic) == 0;
+  // The bounded reader: a FIFO, a directory or a device is no recording (and opening it never
+  // blocks); the scenario loader then names what it is.
+  InputFile in;
+  std::string expected;
+  uint8_t magic[sizeof sgr::kMagic] = {};
+  return in.open(path, InputLimits::kRecordingBytes, &expected) && in.size() >= sizeof magic &&
+         in.readAt(0, magic, &expected) && std::memcmp(magic, sgr::kMagic, sizeof magic) == 0;
+}
+
+sgr::Recording readRecordingFile(const std::string& path) {
+  std::vector<uint8_t> bytes;
+  std::string expected;
+  if (!readInputFile(path, InputLimits::kRecordingBytes, &bytes, &expected))
+    throw sgr::RecordingError(path, 0, expected);
+  return sgr::parseRecording(std::move(bytes), path);
 }
 
 std::unique_ptr<Playback> Playback::open(const std::string& path, int threads) {
   std::unique_ptr<Playback> p(new Playback());
   p->threads_ = threads;
-  p->rec_ = std::make_unique<sgr::Recording>(sgr::readRecording(path));
+  p->rec_ = std::make_unique<sgr::Recording>(readRecordingFile(path));
   if (p->rec_->truncated)  // the CLI's warning: what is there still plays
     std::fprintf(stderr,
                  "simgrass-viewer: warning: %s: byte %" PRIu64 ": expected %s; playing the %" PRId64
@@ -36,7 +50,7 @@ std::unique_ptr<Playback> Playback::open(const std::string& path, int threads) {
 }
 
 void Playback::attachRecording(const std::string& path) {
-  recB_ = std::make_unique<sgr::Recording>(sgr::readRecording(path));
+  recB_ = std::make_unique<sgr::Recording>(readRecordingFile(path));
   const Rational dtA = recordedTimeStep(*rec_), dtB = recordedTimeStep(*recB_);
   if (!(dtA == dtB))
     throw std::invalid_argument(path + ": expected a recording with A's time step " + dtA.toString() + ", got " +
@@ -68,22 +82,37 @@ void Playback::buildB() {
   syncB();
 }
 
-/// Brings B to A's tick (or the last common tick before it) and measures the divergence there.
-void Playback::syncB() {
-  if (!b_) return;
-  const int64_t t = tick();
+/// B's target for A's tick: the last common tick at or before it (B may end earlier).
+int64_t Playback::commonTickB() const {
   const int64_t m = b_->mergedTicks();
-  int64_t target = t / m * m;
-  target = std::min(target, (recB_ ? recB_->lastTick() : rec_->lastTick()) / m * m);
-  if (target < b_->recordedTick()) {
-    if (m == 1 && b_->substeps() == 1) {
-      const StepResult r = b_->player().seek(target);
-      if (!r.ok) return;
-    } else {
-      b_ = std::make_unique<LockStepReplay>(recB_ ? *recB_ : *rec_, threads_, variantB_);
+  return std::min(tick() / m * m, (recB_ ? recB_->lastTick() : rec_->lastTick()) / m * m);
+}
+
+/// Moves B back when it is past `target`: to its nearest snapshot (or its start) at or before
+/// it, restoring only (the steps from there are syncB's or work()'s). False, B unmeasured, when
+/// B's snapshot is damaged or the restore fails.
+bool Playback::rewindB(int64_t target, std::string* why) {
+  if (target >= b_->recordedTick()) return true;
+  try {
+    if (b_->mergedTicks() == 1 && b_->substeps() == 1) {
+      const sgr::Recording& r = recB_ ? *recB_ : *rec_;
+      const sgr::SnapshotInfo* snap = b_->player().sameSettingsAsRecorded() ? r.snapshotAtOrBefore(target) : nullptr;
+      const StepResult step = b_->player().seek(snap ? snap->tick : r.header.startTick);
+      if (!step.ok && why) *why = labelB_ + ": " + step.error.message();
+      return step.ok;
     }
+    b_ = std::make_unique<LockStepReplay>(recB_ ? *recB_ : *rec_, threads_, variantB_);
+    return true;
+  } catch (const std::exception& e) {  // sgr::RecordingError: a damaged snapshot of B
+    if (why) *why = e.what();
+    return false;
   }
-  if (!b_->advanceTo(target).ok || b_->recordedTick() != t) {
+}
+
+/// Measures A against B (B at A's tick; else B stays unmeasured).
+void Playback::measureB() {
+  const int64_t t = tick();
+  if (b_->recordedTick() != t) {
     measured_ = false;
     return;
   }
@@ -92,6 +121,24 @@ void Playback::syncB() {
   last_ = measureDivergence(obsA_, obsB_, player_->world().stateHash() == b_->world().stateHash());
   measured_ = true;
   if (last_.observedDifference() && (firstDivergent_ < 0 || t < firstDivergent_)) firstDivergent_ = t;
+}
+
+/// Brings B to A's tick (or the last common tick before it) and measures the divergence there,
+/// at once: for single steps, where B is at most one step behind.
+void Playback::syncB() {
+  if (!b_) return;
+  const int64_t target = commonTickB();
+  measured_ = false;
+  if (!rewindB(target, nullptr) || !b_->advanceTo(target).ok) return;
+  measureB();
+}
+
+/// After a seek of A: B rewinds now and catches up in work()'s slices (a variant B has no
+/// snapshots and replays from its start). False with *why when B cannot rewind (B unmeasured).
+bool Playback::beginCatchUpB(std::string* why) {
+  measured_ = false;
+  catchingUpB_ = b_ && rewindB(commonTickB(), why);
+  return !b_ || catchingUpB_;
 }
 
 void Playback::checkHash() {
@@ -113,25 +160,24 @@ void Playback::checkHash() {
 }
 
 bool Playback::step(int64_t n, std::string* error) {
-  for (int64_t i = 0; i < n && tick() < lastTick(); ++i) {
-    const StepResult r = player_->stepForward();
-    if (!r.ok) {
-      *error = r.error.message();
-      playing = false;
-      return false;
-    }
-    checkHash();
-    syncB();
-  }
-  return true;
+  if (n <= 0 || tick() >= lastTick()) return true;
+  target_ = tick() + std::min(n, lastTick() - tick());
+  checkEachTick_ = true;
+  return work(0, error);  // one tick now (a single step is immediate), the rest frame by frame
 }
 
 bool Playback::advance(double wallTicks, std::string* error) {
-  if (!playing) return true;
+  if (!playing || busy()) return true;
   accumulator_ += wallTicks * speed;
   const int64_t n = int64_t(std::floor(accumulator_));
   accumulator_ -= double(n);
-  const bool ok = step(n, error);
+  bool ok = true;
+  for (int64_t i = 0; ok && i < n && tick() < lastTick(); ++i) {
+    target_ = tick() + 1;
+    checkEachTick_ = true;
+    ok = work(0, error);
+  }
+  if (!ok) playing = false;
   if (tick() >= lastTick()) {
     playing = false;
     accumulator_ = 0;
@@ -142,18 +188,75 @@ bool Playback::advance(double wallTicks, std::string* error) {
 bool Playback::seek(int64_t t, std::string* error) {
   t = std::clamp<int64_t>(t, rec_->header.startTick, lastTick());
   accumulator_ = 0;
+  cancel();
+  // The jump now (what Player::seek does first): the nearest snapshot at or before t, or the
+  // start, unless stepping on from here is shorter. Player::seek to that tick restores it and
+  // steps nothing; the steps from there to t are work()'s.
+  const sgr::SnapshotInfo* snap = hashesComparable() ? rec_->snapshotAtOrBefore(t) : nullptr;
+  const int64_t from = tick();
+  const bool forwardIsShorter = from <= t && (!snap || snap->tick <= from);
   try {
-    const StepResult r = player_->seek(t);
-    if (!r.ok) {
-      *error = r.error.message();
-      return false;
+    if (!forwardIsShorter) {
+      const StepResult r = player_->seek(snap ? snap->tick : rec_->header.startTick);
+      if (!r.ok) {
+        *error = r.error.message();
+        return false;
+      }
     }
   } catch (const sgr::RecordingError& e) {
     *error = e.what();
     return false;
   }
-  checkHash();
-  syncB();
+  if (tick() == t) {
+    checkHash();
+    return beginCatchUpB(error) && work(0, error);
+  }
+  target_ = t;
+  checkEachTick_ = false;
+  return work(0, error);
+}
+
+bool Playback::work(double seconds, std::string* error) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  while (busy()) {
+    if (target_ >= 0 && tick() < target_) {
+      StepResult r;
+      std::string why;
+      try {
+        r = player_->stepForward();
+      } catch (const sgr::RecordingError& e) {
+        r.ok = false;
+        why = e.what();
+      }
+      if (!r.ok) {
+        *error = why.empty() ? r.error.message() : why;
+        cancel();
+        playing = false;
+        return false;
+      }
+      if (checkEachTick_) {
+        checkHash();
+        syncB();
+      }
+    }
+    if (target_ >= 0 && tick() >= target_) {
+      target_ = -1;
+      if (!checkEachTick_) {
+        checkHash();
+        if (!beginCatchUpB(error)) return false;
+      }
+    } else if (target_ < 0 && catchingUpB_) {
+      // B, one of its steps at a time (m recorded ticks), up to A's tick.
+      const int64_t bt = commonTickB();
+      if (b_->recordedTick() < bt && !b_->advanceTo(b_->recordedTick() + b_->mergedTicks()).ok) catchingUpB_ = false;
+      if (catchingUpB_ && b_->recordedTick() >= bt) {
+        catchingUpB_ = false;
+        measureB();
+      }
+    }
+    if (std::chrono::duration<double>(Clock::now() - start).count() >= seconds) break;
+  }
   return true;
 }
 

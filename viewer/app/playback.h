@@ -17,6 +17,9 @@ namespace sg::viewer {
 
 /// True for a path ending in ".sgr" or a file starting with the recording magic.
 bool looksLikeRecording(const std::string& path);
+/// Reads a recording through the bounded reader (replay/input_file.h) and parses it. Throws
+/// sgr::RecordingError ("file: byte 0: expected a regular file, got a FIFO" and the parser's lines).
+sgr::Recording readRecordingFile(const std::string& path);
 
 class Playback {
  public:
@@ -40,12 +43,28 @@ class Playback {
   double speed = 1;  ///< recorded ticks per tick of wall-clock time (0.25 ... 8)
 
   /// Plays for `wallTicks` ticks' worth of wall-clock time (1 in a scripted frame) at `speed`;
-  /// pauses at the end. Returns false with *error on a fault or a damaged snapshot.
+  /// pauses at the end. Does nothing while a seek or step is pending (work() runs it). Returns
+  /// false with *error on a fault or a damaged snapshot.
   bool advance(double wallTicks, std::string* error);
-  /// Steps n ticks (stops at the end).
+  /// Starts stepping n ticks (stops at the end), each one's hash checked: the steps run in work(),
+  /// a frame's budget at a time (a step of 100000000 ticks never freezes the window).
   bool step(int64_t n, std::string* error);
-  /// Moves to tick t (0 ≤ t ≤ lastTick(), clamped) through the nearest snapshot.
+  /// Starts moving to tick t (clamped to the recording, so never past lastTick()): the nearest
+  /// snapshot is restored at once, the ticks from there to t run in work().
   bool seek(int64_t t, std::string* error);
+  /// A seek or step is under way, or B catching up with A after a seek (target() is where A goes).
+  bool busy() const { return target_ >= 0 || catchingUpB_; }
+  int64_t target() const { return target_ >= 0 ? target_ : tick(); }
+  /// Stops a pending seek or step where it stands (a consistent state: a whole tick); B stays
+  /// unmeasured until the next step or seek.
+  void cancel() {
+    target_ = -1;
+    if (catchingUpB_) measured_ = false;
+    catchingUpB_ = false;
+  }
+  /// Runs a pending seek or step for about `seconds` of wall time (at least one tick). Returns
+  /// false with *error (one line) on a fault or a damaged snapshot; the pending move then stops.
+  bool work(double seconds, std::string* error);
 
   // ---- the recorded hashes ----
   int64_t hashesOk() const { return int64_t(okTicks_.size()); }
@@ -73,12 +92,19 @@ class Playback {
   void checkHash();
   void buildB();
   void syncB();
+  int64_t commonTickB() const;
+  bool rewindB(int64_t target, std::string* why);
+  void measureB();
+  bool beginCatchUpB(std::string* why);
   std::unique_ptr<sgr::Recording> rec_, recB_;
   std::unique_ptr<Player> player_;
   RecordedHashes* hashes_ = nullptr;
   std::unique_ptr<RecordedHashes> hashesOwned_;
   int threads_ = 1;
-  double accumulator_ = 0;  ///< recorded ticks not yet run
+  double accumulator_ = 0;      ///< recorded ticks not yet run
+  int64_t target_ = -1;         ///< where a pending seek or step goes (-1: none)
+  bool catchingUpB_ = false;    ///< after a seek: B steps towards A's tick in work()'s slices
+  bool checkEachTick_ = false;  ///< step: every tick's hash checked and B synced; seek: only the last
   std::set<int64_t> okTicks_;
   int64_t firstMismatch_ = -1;
   std::string mismatchText_;

@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "viewer/app/text.h"
+
 namespace sg::viewer {
 
 int scriptKeyCode(const std::string& name) {
@@ -62,11 +64,9 @@ bool parseScript(const std::string& text, const std::string& file, std::vector<S
     ScriptCommand c;
     c.line = lineNo;
     const std::string& cmd = w[0];
-    // The line, quoted for messages (control characters dropped: the message stays one line).
-    std::string shown;
-    for (char ch : raw)
-      if (static_cast<unsigned char>(ch) >= 0x20) shown += ch;
-    if (shown.size() > 80) shown = shown.substr(0, 80) + "...";
+    // The line, quoted for messages: control characters escaped and at most 60 characters of
+    // it, so the message stays one short line whatever the script holds.
+    const std::string shown = shownText(raw);
     if (cmd == "frames") {
       c.kind = ScriptCommand::Kind::Frames;
       if (w.size() != 2 || !parseCount(w[1], 100000000, &c.count))
@@ -103,11 +103,12 @@ bool parseScript(const std::string& text, const std::string& file, std::vector<S
     } else if (cmd == "quit") {
       c.kind = ScriptCommand::Kind::Quit;
       if (w.size() != 1) return fail("expected 'quit', got '" + shown + "'");
-    } else if (cmd == "play" || cmd == "pause" || cmd == "regenerate" || cmd == "print") {
+    } else if (cmd == "play" || cmd == "pause" || cmd == "regenerate" || cmd == "print" || cmd == "status") {
       c.kind = cmd == "play"         ? ScriptCommand::Kind::Play
                : cmd == "pause"      ? ScriptCommand::Kind::Pause
                : cmd == "regenerate" ? ScriptCommand::Kind::Regenerate
-                                     : ScriptCommand::Kind::Print;
+               : cmd == "print"      ? ScriptCommand::Kind::Print
+                                     : ScriptCommand::Kind::Status;
       if (w.size() != 1)
         return fail(std::string("expected '").append(cmd).append("' alone, got '").append(shown).append("'"));
     } else if (cmd == "step") {
@@ -150,7 +151,7 @@ bool parseScript(const std::string& text, const std::string& file, std::vector<S
     } else {
       return fail("unknown command '" + shown +
                   "' (expected frames, key, camera, select, record, screenshot, quit, play, pause, step, seek, "
-                  "speed, ab, open, set, regenerate, lod or print)");
+                  "speed, ab, open, set, regenerate, lod, print or status)");
     }
     out->push_back(c);
   }

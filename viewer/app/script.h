@@ -32,6 +32,7 @@ struct ScriptCommand {
     Regenerate,
     Lod,
     Print,
+    Status,
   } kind = Kind::Quit;
   int64_t count = 0;  ///< frames N; select N; step N; seek T; lod 1|0; ab 0 (side) | 1 (overlay)
   double number = 0;  ///< speed X

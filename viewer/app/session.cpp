@@ -3,10 +3,9 @@
 #include <cinttypes>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <nlohmann/json.hpp>
 
+#include "replay/input_file.h"
 #include "replay/scenario_files.h"
 #include "viewer/app/text.h"
 
@@ -18,17 +17,13 @@ ScenarioFileReader relativeReader(const std::string& dir, std::vector<sgr::Embed
   return [dir, files](const std::string& name, std::vector<uint8_t>* out, std::string* why) {
     namespace fs = std::filesystem;
     const fs::path p = fs::path(name).is_absolute() || dir.empty() ? fs::path(name) : fs::path(dir) / name;
-    std::error_code ec;
-    if (!fs::is_regular_file(p, ec)) {
-      *why = "an existing file, '" + p.string() + "' was not found";
+    // The bounded reader (regular files only, never blocks, size checked first), as
+    // loadScenarioFile reads the same names.
+    std::string expected;
+    if (!readInputFile(p.string(), InputLimits::kHeightmapBytes, out, &expected)) {
+      *why = "'" + shownText(name) + "' to be " + expected;
       return false;
     }
-    std::ifstream in(p, std::ios::binary);
-    if (!in) {
-      *why = "a readable file, '" + p.string() + "'";
-      return false;
-    }
-    out->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     files->push_back(sgr::EmbeddedFile{name, *out});
     return true;
   };
@@ -62,7 +57,20 @@ std::unique_ptr<Session> Session::rebuilt(const std::string& text, bool replayHi
 
 StepResult Session::step(const TickInput& input) {
   history.push_back(input);
-  return recorder ? recorder->step(input, &clock) : world->step(input, &clock);
+  if (!recorder) return world->step(input, &clock);
+  const int64_t before = world->tick();
+  try {
+    return recorder->step(input, &clock);
+  } catch (const std::exception& e) {
+    // A write that failed (a full disk, a file-size limit): the recording ends at its last
+    // complete chunk (still readable, as a recording cut off by a crash) and the session goes on
+    // unrecorded; the caller shows recordingError. The writer appends the tick's input before
+    // stepping and writes after it, so the world has stepped unless the step itself failed.
+    recordingError = std::string(e.what()) + " (the recording stopped there, the session goes on)";
+    recorder.reset();
+    if (world->tick() == before) return world->step(input, &clock);
+    return {};
+  }
 }
 
 bool Session::startRecording(const std::string& path, std::string* error) {
@@ -116,20 +124,85 @@ bool Session::stopRecording(std::string* error) {
   return true;
 }
 
+void editScenarioJson(nlohmann::json* doc, const std::string& sourceName, const std::string& dotted,
+                      const std::string& valueJson) {
+  nlohmann::json& j = *doc;
+  if (!j.is_object()) throw ScenarioError(sourceName, "$", "a JSON object to edit");
+  const std::string where = "$." + shownText(dotted);
+  // The path: dotted segments, few and short (each one is a nesting level of the result).
+  std::vector<std::string> segments;
+  if (dotted.size() > EditLimits::kPathChars)
+    throw ScenarioError(sourceName, where,
+                        "a path of at most " + std::to_string(EditLimits::kPathChars) + " characters");
+  for (size_t at = 0;;) {
+    const size_t dot = dotted.find('.', at);
+    segments.push_back(dotted.substr(at, dot == std::string::npos ? std::string::npos : dot - at));
+    if (segments.back().empty()) throw ScenarioError(sourceName, where, "a dotted path of names (a.b.c)");
+    try {  // a name that is not UTF-8 would make every later dump of the scenario throw
+      (void)nlohmann::json(segments.back()).dump();
+    } catch (const nlohmann::json::exception&) {
+      throw ScenarioError(sourceName, where, "a path of UTF-8 names");
+    }
+    if (dot == std::string::npos) break;
+    at = dot + 1;
+  }
+  if (segments.size() > EditLimits::kPathSegments)
+    throw ScenarioError(sourceName, where, "a path of at most " + std::to_string(EditLimits::kPathSegments) + " names");
+  // The value: its depth is counted before parsing, so a value 100000 levels deep never reaches
+  // nlohmann's recursive code (dump, destructor) and never reaches a message.
+  const int budget = EditLimits::kJsonDepth - int(segments.size());
+  if (jsonNestingDepth(valueJson, budget) > budget)
+    throw ScenarioError(
+        sourceName, where,
+        "a JSON value nested at most " + std::to_string(budget) + " levels deep, got '" + shownText(valueJson) + "'");
+  nlohmann::json v = nlohmann::json::parse(valueJson, nullptr, false);
+  if (v.is_discarded()) throw ScenarioError(sourceName, where, "a JSON value, got '" + shownText(valueJson) + "'");
+  // Walks the path by hand (not json_pointer, whose "/list/50000000" fills an array with 50 M
+  // nulls): objects take any name, arrays an index up to their size (the size appends one).
+  nlohmann::json* node = &j;
+  for (size_t k = 0; k < segments.size(); ++k) {
+    const std::string& name = segments[k];
+    if (node->is_null()) *node = nlohmann::json::object();
+    if (node->is_object()) {
+      node = &(*node)[name];
+    } else if (node->is_array()) {
+      const size_t size = node->size();
+      size_t index = 0;
+      bool number = name.size() <= 9;
+      for (char c : name) number = number && c >= '0' && c <= '9';
+      if (number) index = size_t(std::stoul(name));
+      if (!number || index > size)
+        throw ScenarioError(sourceName, where,
+                            "an index from 0 to " + std::to_string(size) + " at '" + shownText(name) + "'");
+      if (index == size) {
+        if (size >= EditLimits::kArrayEntries)
+          throw ScenarioError(sourceName, where,
+                              "a list of at most " + std::to_string(EditLimits::kArrayEntries) + " entries");
+        node->push_back(nullptr);
+      }
+      node = &(*node)[index];
+    } else {
+      throw ScenarioError(sourceName, where, "a path of objects and lists ('" + shownText(name) + "' is in a value)");
+    }
+  }
+  *node = std::move(v);
+}
+
 std::string editScenarioText(const std::string& text, const std::string& sourceName, const std::string& dotted,
                              const std::string& valueJson) {
+  nlohmann::json j = parseScenarioJsonForEdit(text, sourceName);
+  editScenarioJson(&j, sourceName, dotted, valueJson);
+  return j.dump(2);
+}
+
+nlohmann::json parseScenarioJsonForEdit(const std::string& text, const std::string& sourceName) {
+  // The live scenario's text was parsed (and bounded) once already; counted again all the same.
+  if (jsonNestingDepth(text, EditLimits::kJsonDepth) > EditLimits::kJsonDepth)
+    throw ScenarioError(sourceName, "$",
+                        "a JSON object nested at most " + std::to_string(EditLimits::kJsonDepth) + " levels deep");
   nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
   if (!j.is_object()) throw ScenarioError(sourceName, "$", "a JSON object to edit");
-  nlohmann::json v = nlohmann::json::parse(valueJson, nullptr, false);
-  if (v.is_discarded()) throw ScenarioError(sourceName, "$." + dotted, "a JSON value, got '" + valueJson + "'");
-  std::string pointer;
-  for (char c : dotted) pointer += c == '.' ? '/' : c;
-  try {
-    j[nlohmann::json::json_pointer("/" + pointer)] = v;
-  } catch (const nlohmann::json::exception&) {
-    throw ScenarioError(sourceName, "$." + dotted, "a path of objects");
-  }
-  return j.dump(2);
+  return j;
 }
 
 }  // namespace sg::viewer

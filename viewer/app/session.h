@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 
@@ -34,7 +35,10 @@ class Session {
   /// ScenarioError naming the tick.
   std::unique_ptr<Session> rebuilt(const std::string& text, bool replayHistory) const;
 
+  /// One tick (recorded when recording). A recording write that fails stops the recording, sets
+  /// recordingError (one line) and the session goes on.
   StepResult step(const TickInput& input);
+  std::string recordingError;  ///< set by step() when the recording stopped on a write error
 
   /// Records the whole session, from tick 0, to `path`: a fresh world replays the inputs so far
   /// under a Recorder (a recording must start from a state a replay can build), must reach the
@@ -45,9 +49,16 @@ class Session {
 };
 
 /// The scenario text with one value replaced: `dotted` is a path such as "field.patchesX" or
-/// "bodies.gravity", `value` any JSON value. Throws ScenarioError (file, "$.dotted", expected)
-/// when the text is not an object.
+/// "bodies.gravity" (a list takes an index up to its size; the size appends), `value` any JSON
+/// value. Throws ScenarioError (file, "$.dotted", expected) when the text is not an object, the
+/// path or value breaks EditLimits (text.h) or the value is not JSON; echoed text is truncated.
 std::string editScenarioText(const std::string& text, const std::string& sourceName, const std::string& dotted,
                              const std::string& valueJson);
+
+/// The same edit on an already parsed scenario (what repeated `set` lines stage, parsed once).
+void editScenarioJson(nlohmann::json* doc, const std::string& sourceName, const std::string& dotted,
+                      const std::string& valueJson);
+/// Parses scenario text for editing (depth bounded first). Throws ScenarioError unless an object.
+nlohmann::json parseScenarioJsonForEdit(const std::string& text, const std::string& sourceName);
 
 }  // namespace sg::viewer

@@ -12,7 +12,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -20,6 +19,8 @@
 
 #include "replay/cli/cli_common.h"
 #include "replay/format/sgr_format.h"
+#include "replay/format/sgr_reader.h"
+#include "replay/input_file.h"
 #include "replay/player.h"
 #include "replay/progress.h"
 #include "replay/scenario_files.h"
@@ -65,6 +66,11 @@ bool parseDebugList(const std::string& list, viewer::DebugFlags* flags, std::str
 }
 
 constexpr int64_t kMaxFrames = 1000000;
+/// Samples one frame may take (width x height x max(1, msaa)): 8192x8192 without MSAA, 4096x4096
+/// at 4x; at about 8 bytes a sample (colour + depth) that is 512 MiB of framebuffer at most.
+constexpr int64_t kMaxFrameSamples = int64_t(1) << 26;
+/// Frames a contact sheet may hold (each keeps a thumbnail of up to 320 px wide in memory).
+constexpr int64_t kMaxContactSheetFrames = 256;
 
 struct TickRange {
   int64_t first = 0, last = 0, step = 1;
@@ -133,11 +139,22 @@ std::optional<viewer::Camera> parseCamera(const std::string& s) {
   return c;
 }
 
+/// A file starting with the recording magic, opened through the bounded reader (a FIFO, a
+/// directory or a device is not a recording: the scenario loader then names what it is).
 bool isRecording(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  char magic[sizeof sgr::kMagic] = {};
-  in.read(magic, sizeof magic);
-  return in && std::equal(std::begin(magic), std::end(magic), reinterpret_cast<const char*>(sgr::kMagic));
+  InputFile in;
+  std::string expected;
+  uint8_t magic[sizeof sgr::kMagic] = {};
+  return in.open(path, InputLimits::kRecordingBytes, &expected) && in.size() >= sizeof magic &&
+         in.readAt(0, magic, &expected) && std::equal(std::begin(magic), std::end(magic), std::begin(sgr::kMagic));
+}
+
+sgr::Recording readRecordingFile(const std::string& path) {
+  std::vector<uint8_t> bytes;
+  std::string expected;
+  if (!readInputFile(path, InputLimits::kRecordingBytes, &bytes, &expected))
+    throw sgr::RecordingError(path, 0, expected);
+  return sgr::parseRecording(std::move(bytes), path);
 }
 
 double rawToMetres(int64_t raw) { return double(raw) / 4294967296.0; }
@@ -251,6 +268,22 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+/// An argument quoted in a message: control characters escaped, at most 60 characters.
+std::string shown(const std::string& s) {
+  std::string out;
+  for (size_t i = 0; i < s.size() && i < 60; ++i) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    if (c < 0x20 || c == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out += char(c);
+    }
+  }
+  return s.size() > 60 ? out + "..." : out;
+}
+
 int fail(int code, const std::string& message) {
   std::fprintf(stderr, "simgrass render: %s\n", message.c_str());
   return code;
@@ -261,26 +294,41 @@ int render(const RenderOptions& o) {
   const std::optional<TickRange> range = parseTicks(o.ticks);
   if (!range)
     return fail(kExitBadInput, "--ticks: expected T, A:B or A:B:STEP with 0 <= A <= B, STEP >= 1 and at most " +
-                                   std::to_string(kMaxFrames) + " frames, got '" + o.ticks + "'");
+                                   std::to_string(kMaxFrames) + " frames, got '" + shown(o.ticks) + "'");
   int width = 0, height = 0;
   if (!parseSize(o.size, &width, &height))
-    return fail(kExitBadInput, "--size: expected WxH with both from 16 to 8192, got '" + o.size + "'");
+    return fail(kExitBadInput, "--size: expected WxH with both from 16 to 8192, got '" + shown(o.size) + "'");
   std::optional<viewer::Camera> fixedCamera;
   if (!o.camera.empty()) {
     fixedCamera = parseCamera(o.camera);
     if (!fixedCamera)
       return fail(kExitBadInput,
-                  "--camera: expected x,y,z,yaw,pitch (m, degrees; |pitch| <= 90), got '" + o.camera + "'");
+                  "--camera: expected x,y,z,yaw,pitch (m, degrees; |pitch| <= 90), got '" + shown(o.camera) + "'");
   }
   if (o.msaa != 0 && o.msaa != 2 && o.msaa != 4 && o.msaa != 8)
     return fail(kExitBadInput, "--msaa: expected 0, 2, 4 or 8, got " + std::to_string(o.msaa));
+  const int64_t samples = int64_t(width) * int64_t(height) * std::max(1, o.msaa);
+  if (samples > kMaxFrameSamples)
+    return fail(kExitBadInput, "--size, --msaa: expected at most " + std::to_string(kMaxFrameSamples) +
+                                   " samples a frame (width x height x msaa), got " + std::to_string(samples) + " (" +
+                                   shown(o.size) + ", msaa " + std::to_string(o.msaa) + ")");
+  const int64_t frameCount = (range->last - range->first) / range->step + 1;
+  if (!o.contactSheet.empty() && frameCount > kMaxContactSheetFrames)
+    return fail(kExitBadInput, "--contact-sheet: expected at most " + std::to_string(kMaxContactSheetFrames) +
+                                   " frames on a sheet, got " + std::to_string(frameCount) + " (--ticks " +
+                                   shown(o.ticks) + ")");
+  // No output may replace an input of this command (a frame, the sheet or the video named as
+  // the scenario or recording being rendered).
+  for (const std::string* out : {&o.contactSheet, &o.video})
+    if (!out->empty() && sameFile(*out, o.input))
+      return fail(kExitBadInput, *out + ": expected an output file other than the input " + o.input);
   viewer::DebugFlags debug;
   std::string badItem;
   if (!parseDebugList(o.debug, &debug, &badItem))
     return fail(kExitBadInput,
                 "--debug: expected a comma list of particles, constraints, primitives, cells, contacts, got '" +
-                    o.debug + "'" +
-                    (badItem.empty() || badItem == o.debug ? "" : " ('" + badItem + "' is none of them)"));
+                    shown(o.debug) + "'" +
+                    (badItem.empty() || badItem == o.debug ? "" : " ('" + shown(badItem) + "' is none of them)"));
 
   // ---- the world ----
   Scenario scenario;
@@ -289,7 +337,7 @@ int render(const RenderOptions& o) {
   std::unique_ptr<Player> player;
   try {
     if (isRecording(o.input)) {
-      recording = std::make_unique<sgr::Recording>(sgr::readRecording(o.input));
+      recording = std::make_unique<sgr::Recording>(readRecordingFile(o.input));
       player = std::make_unique<Player>(*recording, o.threads);
       scenario = player->scenario();
       if (range->last > recording->lastTick())
@@ -377,6 +425,8 @@ int render(const RenderOptions& o) {
       char name[32];
       std::snprintf(name, sizeof name, "frame-%06" PRId64 ".png", tick);
       const std::string file = (fs::path(o.output) / name).string();
+      if (sameFile(file, o.input))
+        return fail(kExitBadInput, file + ": expected an output file other than the input " + o.input);
       const auto t3 = Clock::now();
       if (!viewer::writePng(file, image, &error)) return fail(kExitBadInput, error);
       writeMs.push_back(ms(t3, Clock::now()));

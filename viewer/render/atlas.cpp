@@ -14,6 +14,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "replay/output_file.h"
+
 namespace sg::viewer {
 namespace {
 
@@ -469,17 +471,39 @@ Image makeRockTexture(uint64_t seed, int size) {
 
 // ---- PNG -----------------------------------------------------------------------------------
 
+bool encodePng(const Image& image, std::vector<uint8_t>* png, std::string* error) {
+  if (image.width <= 0 || image.height <= 0 || image.rgba.size() != size_t(image.width) * size_t(image.height) * 4) {
+    if (error)
+      *error = "not a valid RGBA image (" + std::to_string(image.width) + " x " + std::to_string(image.height) + ")";
+    return false;
+  }
+  png->clear();
+  auto append = [](void* context, void* data, int size) {
+    auto* out = static_cast<std::vector<uint8_t>*>(context);
+    const auto* bytes = static_cast<const uint8_t*>(data);
+    out->insert(out->end(), bytes, bytes + size);
+  };
+  if (stbi_write_png_to_func(append, png, image.width, image.height, 4, image.rgba.data(), image.width * 4) == 0) {
+    if (error) *error = "cannot encode the PNG";
+    return false;
+  }
+  return true;
+}
+
 bool writePng(const std::string& path, const Image& image, std::string* error) {
-  auto fail = [&](const std::string& why) {
+  // Encoded in memory, then written atomically with every write checked (a full disk is an
+  // error, never a truncated PNG left behind).
+  std::vector<uint8_t> png;
+  std::string why;
+  if (!encodePng(image, &png, &why)) {
     if (error) *error = path + ": " + why;
     return false;
-  };
-  if (image.width <= 0 || image.height <= 0 || image.rgba.size() != size_t(image.width) * size_t(image.height) * 4)
-    return fail("not a valid RGBA image (" + std::to_string(image.width) + " x " + std::to_string(image.height) + ")");
-  errno = 0;
-  if (stbi_write_png(path.c_str(), image.width, image.height, 4, image.rgba.data(), image.width * 4) == 0)
-    return fail(std::string("cannot write PNG") +
-                (errno != 0 ? std::string(" (") + std::strerror(errno) + ")" : std::string()));
+  }
+  std::string e;
+  if (!writeFileAtomic(path, png, &e)) {
+    if (error) *error = e;
+    return false;
+  }
   return true;
 }
 

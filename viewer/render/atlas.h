@@ -71,7 +71,11 @@ Image makeGroundTexture(const TuftAtlas& atlas, uint64_t seed, int size = 256);
 /// Opaque. Throws std::invalid_argument if size is not a power of two in 4..8192.
 Image makeRockTexture(uint64_t seed, int size = 256);
 
-/// Writes a PNG (stb_image_write). Returns false with *error = "path: why" on failure.
+/// Encodes a PNG in memory (stb_image_write's callback writer). False with *error on failure.
+bool encodePng(const Image& image, std::vector<uint8_t>* png, std::string* error);
+
+/// Writes a PNG atomically (encodePng, then replay/output_file.h's writeFileAtomic: temporary
+/// file, every write checked, rename). Returns false with *error = one line naming the file.
 bool writePng(const std::string& path, const Image& image, std::string* error);
 
 }  // namespace sg::viewer
