@@ -108,8 +108,8 @@ std::vector<uint8_t> mutate(std::vector<uint8_t> bytes) {
         bytes.resize(at);
         break;
       case 3: {
-        const std::vector<uint8_t> extra = *rc::gen::container<std::vector<uint8_t>>(
-            *rc::gen::inRange<size_t>(1, 9), rc::gen::arbitrary<uint8_t>());
+        const std::vector<uint8_t> extra =
+            *rc::gen::container<std::vector<uint8_t>>(*rc::gen::inRange<size_t>(1, 9), rc::gen::arbitrary<uint8_t>());
         bytes.insert(bytes.begin() + std::ptrdiff_t(at), extra.begin(), extra.end());
         break;
       }
@@ -173,8 +173,8 @@ const ReferenceRecording& reference() {
     RecordingSettings settings;
     settings.checkEvery = 3;
     settings.snapshotEvery = 8;
-    RecordingSession session = RecordingSession::fromScenarioFile(test::sourcePath("scenarios/thesis-bodies.json"),
-                                                                  path, settings);
+    RecordingSession session =
+        RecordingSession::fromScenarioFile(test::sourcePath("scenarios/thesis-bodies.json"), path, settings);
     r->hashAtTick[0] = session.stateHash();
     for (int t = 0; t < 30; ++t) {
       session.stepScripted(1);
@@ -272,9 +272,21 @@ RC_GTEST_PROP(MutationProperty, AnExtremeValueInAnyNumberIsRefusedOrSteps, ()) {
   numberPointers(j, json::json_pointer(), &numbers);
   RC_PRE(!numbers.empty());
   const json::json_pointer target = numbers[*rc::gen::inRange<size_t>(0, numbers.size())];
-  static const char* const kExtremes[] = {"0",     "-1",          "1e-30",          "1e30",       "-1e30",
-                                          "32767", "32768",       "-32769",         "65536",      "2147483647",
-                                          "2147483648", "-2147483649", "9223372036854775807", "1e-9", "123456.789"};
+  static const char* const kExtremes[] = {"0",
+                                          "-1",
+                                          "1e-30",
+                                          "1e30",
+                                          "-1e30",
+                                          "32767",
+                                          "32768",
+                                          "-32769",
+                                          "65536",
+                                          "2147483647",
+                                          "2147483648",
+                                          "-2147483649",
+                                          "9223372036854775807",
+                                          "1e-9",
+                                          "123456.789"};
   const std::string value = kExtremes[*rc::gen::inRange<size_t>(0, std::size(kExtremes))];
   j[target] = json::parse(value);
   std::string text = j.dump();
