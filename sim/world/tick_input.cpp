@@ -31,6 +31,48 @@ void setCamera(const std::vector<CameraKey>& keys, int64_t tick, TickInput& inpu
 }
 }  // namespace
 
+std::string describeInputCause(const Scenario& scenario, const InputTrack* track, int64_t tick, int32_t body) {
+  if (body < 0) return "";
+  static constexpr const char* kCommandNames[] = {"displace", "addVelocity", "impulse", "teleport",
+                                                  "reset",    "spawn",       "mowerOn", "mowerOff"};
+  const std::vector<ScriptedCommand>& commands = track ? track->commands : scenario.script;
+  const std::string& file = track ? track->sourceName : scenario.sourceName;
+  const char* array = track ? "$.commands" : "$.script";
+  // Fixed-point fault bits are per thread, not per body, so the body a fault names is not always
+  // the one that overflowed: blame the latest command at or before the tick (sorted by tick),
+  // the named body's own when several share that tick.
+  const ScriptedCommand* last = nullptr;
+  for (const ScriptedCommand& c : commands) {
+    if (c.tick > tick) break;
+    if (!last || c.tick > last->tick || c.body == body) last = &c;
+  }
+  std::string where;
+  if (last) {
+    where = "last input: " + file + ": " + array + "[" + std::to_string(last->source) + "] (" +
+            kCommandNames[size_t(last->kind)] + " to body " + std::to_string(last->body) + " at tick " +
+            std::to_string(last->tick) + ")";
+  } else if (scenario.bodies.list.size() == 1 && body == 0) {
+    where = "no input before it; the body as given in " + scenario.sourceName + ": $.bodies.list[0]";
+  } else if (size_t(body) < scenario.bodies.list.size()) {
+    // Not [body]: the fault bits do not say which of the bodies overflowed.
+    where = "no input before it; the bodies as given in " + scenario.sourceName + ": $.bodies.list";
+  } else {
+    return "";
+  }
+  std::string out;  // one line: control characters in a file name are escaped
+  for (unsigned char ch : where) {
+    if (ch < 0x20 || ch == 0x7f) {
+      static constexpr char kHex[] = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[ch >> 4];
+      out += kHex[ch & 15];
+    } else {
+      out += char(ch);
+    }
+  }
+  return out;
+}
+
 TickInput scriptedInput(const Scenario& scenario, int64_t tick) {
   TickInput input;
   setCamera(scenario.camera, tick, input);
