@@ -175,6 +175,17 @@ TEST(ScenarioNumbers, ExponentDigitsAreNeverDropped) {
   EXPECT_FALSE(Rational::parse("1e-99999999999999999999999", &why));
 }
 
+TEST(ScenarioNumbers, ExactWhetherOrNotTheRawTextIsKept) {
+  // Raw number texts are kept only when the double's shortest text is another value; both ways
+  // the scenario gets the exact decimal.
+  const Scenario s = parse(R"({"field": {"spacing": 0.12345678901234567891, "jitter": 1e-1, "scaleY": 2.50},
+                               "particles": {"mass": 12345678901234567891e-19}})");
+  EXPECT_EQ(s.field.spacing, (Rational{Int128(12345678901234567891ull), Int128(10000000000000000000ull) * 10}));
+  EXPECT_EQ(s.field.jitter, (Rational{1, 10}));
+  EXPECT_EQ(s.field.scaleY, (Rational{5, 2}));
+  EXPECT_EQ(s.particles.mass, (Rational{Int128(12345678901234567891ull), Int128(10000000000000000000ull)}));
+}
+
 // ---- 2. and 4. every value fits the chosen scalar, checked at load with its path ---------------
 
 struct RangeCase {

@@ -27,8 +27,11 @@ class RawNumberCollector : public nlohmann::json_sax<json> {
   bool boolean(bool) override { return after(); }
   bool number_integer(number_integer_t) override { return after(); }
   bool number_unsigned(number_unsigned_t) override { return after(); }
-  bool number_float(number_float_t, const string_t& s) override {
-    raw[path()] = s;
+  bool number_float(number_float_t v, const string_t& s) override {
+    // Kept only when the double's shortest text (what Reader::number falls back to) is not the
+    // same exact value: "0.5" or "1e-3" need no entry, so a 16 MiB array of short numbers costs
+    // no per-number path string and map node (it cost ~700 MB before; now the DOM's share).
+    if (!sameExactValue(s, json(v).dump())) raw[path()] = s;
     return after();
   }
   bool string(string_t&) override { return after(); }
@@ -94,6 +97,11 @@ class RawNumberCollector : public nlohmann::json_sax<json> {
       }
     }
     return p;
+  }
+  static bool sameExactValue(const std::string& text, const std::string& shortest) {
+    if (text == shortest) return true;
+    const auto a = Rational::parse(text, nullptr), b = Rational::parse(shortest, nullptr);
+    return a && b && *a == *b;
   }
   bool after() {
     if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
