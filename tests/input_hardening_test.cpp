@@ -354,9 +354,17 @@ TEST(InputCause, NamesTheLatestCommandByFileAndPath) {
             "last input: bad.json: $.script[1] (addVelocity to body 0 at tick 1)");
   // A fault named for body 0 after body 1's impulse: fault bits do not say which body overflowed.
   EXPECT_EQ(describeInputCause(s, nullptr, 8, 0), "last input: bad.json: $.script[3] (impulse to body 1 at tick 7)");
-  EXPECT_EQ(describeInputCause(s, nullptr, 9, 0), "last input: bad.json: $.script[0] (teleport to body 0 at tick 9)");
-  EXPECT_EQ(describeInputCause(s, nullptr, 9, 1), "last input: bad.json: $.script[2] (displace to body 1 at tick 9)");
+  EXPECT_EQ(
+      describeInputCause(s, nullptr, 9, 1),
+      "last input: bad.json: $.script[0] (teleport to body 0 at tick 9), $.script[2] (displace to body 1 at tick 9)");
   EXPECT_EQ(describeInputCause(s, nullptr, 0, 1), "no input before it; the bodies as given in bad.json: $.bodies.list");
+  std::string six;
+  for (int i = 0; i < 6; ++i)
+    six += std::string(i ? "," : "") + R"({"tick": 2, "body": 0, "command": "displace", "value": [0, 0, 0]})";
+  const Scenario many = parse(withBody(R"(, "script": [)" + six + "]"));
+  const std::string cause = describeInputCause(many, nullptr, 3, 0);
+  const std::string tail = "$.script[3] (displace to body 0 at tick 2) and 2 more";
+  EXPECT_EQ(cause.substr(cause.size() - tail.size()), tail) << cause;
   const Scenario one = parse(withBody(""));
   EXPECT_EQ(describeInputCause(one, nullptr, 0, 0),
             "no input before it; the body as given in bad.json: $.bodies.list[0]");

@@ -39,18 +39,26 @@ std::string describeInputCause(const Scenario& scenario, const InputTrack* track
   const std::string& file = track ? track->sourceName : scenario.sourceName;
   const char* array = track ? "$.commands" : "$.script";
   // Fixed-point fault bits are per thread, not per body, so the body a fault names is not always
-  // the one that overflowed: blame the latest command at or before the tick (sorted by tick),
-  // the named body's own when several share that tick.
-  const ScriptedCommand* last = nullptr;
-  for (const ScriptedCommand& c : commands) {
-    if (c.tick > tick) break;
-    if (!last || c.tick > last->tick || c.body == body) last = &c;
-  }
+  // the one that overflowed: name every command of the latest tick at or before the fault (the
+  // script is sorted by tick), at most four.
+  auto latest = std::upper_bound(commands.begin(), commands.end(), tick,
+                                 [](int64_t t, const ScriptedCommand& c) { return t < c.tick; });
   std::string where;
-  if (last) {
-    where = "last input: " + file + ": " + array + "[" + std::to_string(last->source) + "] (" +
-            kCommandNames[size_t(last->kind)] + " to body " + std::to_string(last->body) + " at tick " +
-            std::to_string(last->tick) + ")";
+  if (latest != commands.begin()) {
+    const int64_t at = (latest - 1)->tick;
+    auto first =
+        std::lower_bound(commands.begin(), latest, at, [](const ScriptedCommand& c, int64_t t) { return c.tick < t; });
+    where = "last input: " + file + ":";
+    int listed = 0;
+    for (auto it = first; it != latest; ++it, ++listed) {
+      if (listed == 4) {
+        where += " and " + std::to_string(latest - it) + " more";
+        break;
+      }
+      where += std::string(listed ? ", " : " ") + array + "[" + std::to_string(it->source) + "] (" +
+               kCommandNames[size_t(it->kind)] + " to body " + std::to_string(it->body) + " at tick " +
+               std::to_string(it->tick) + ")";
+    }
   } else if (scenario.bodies.list.size() == 1 && body == 0) {
     where = "no input before it; the body as given in " + scenario.sourceName + ": $.bodies.list[0]";
   } else if (size_t(body) < scenario.bodies.list.size()) {

@@ -45,8 +45,8 @@ TickInput trackInput(const InputTrack& track, int64_t tick);
 int64_t toInputRaw(const Rational& value);
 
 /// Which input a simulation fault of `body` at `tick` most likely came from, for the one-line
-/// error: the latest command at or before the tick (the body's own among those of that tick), by
-/// file and JSON path ("last input: track.json: $.commands[4] (teleport to body 2 at tick 50)"),
+/// error: the commands of the latest tick at or before it (at most four), by file and JSON path
+/// ("last input: track.json: $.commands[4] (teleport to body 2 at tick 50)"),
 /// else the scenario's bodies ("no input before it; the bodies as given in scene.json:
 /// $.bodies.list", or $.bodies.list[0] when there is one body). Commands
 /// come from `track` when given, else the scenario's script. Empty when body < 0 (a particle
