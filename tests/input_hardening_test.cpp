@@ -234,6 +234,10 @@ std::vector<RangeCase> huntCases() {
       {"BoxTooLargeForFx16Norm", R"({"field": {"patchesX": 4, "patchesZ": 4}, "bodies": {"list": [{"name": "b",
         "shape": {"type": "box", "halfExtents": [500, 500, 500]}}]}})",
        "$.bodies.list[0].shape", ScalarKind::Fx16},
+      // A compound of one part: the path is the part's, not the shape's.
+      {"OnePartCompoundOffsetFx16", R"({"field": {"patchesX": 4, "patchesZ": 4}, "bodies": {"list": [{"name": "b",
+        "shape": {"type": "compound", "parts": [{"type": "sphere", "radius": 1, "offset": [0, 9000, 0]}]}}]}})",
+       "$.bodies.list[0].shape.parts[0].offset[1]", ScalarKind::Fx16},
       // Scripted values beyond fx16 became 0 in the step (4.).
       {"ScriptTeleportFx16", withBody(R"(, "script": [{"tick": 0, "body": 0, "command": "teleport",
                                    "value": [40000, 0, 0]}])"),
@@ -286,6 +290,10 @@ TEST(InputTrackRange, Fx16TeleportAndCameraAreRejectedWithTheirPaths) {
   EXPECT_TRUE(
       throwsError([&] { parseInputTrack(head + R"("camera": [{"tick": 0, "position": [1e30, 0, 0]}]})", "t.json", s); },
                   "$.camera[0].position[0]", "", "t.json"));
+  s.scalar = ScalarKind::Float;  // the Q32.32 limit, named as such
+  EXPECT_TRUE(throwsError(
+      [&] { parseInputTrack(head + R"("camera": [{"tick": 0, "position": [2147483648, 0, 0]}]})", "t.json", s); },
+      "$.camera[0].position[0]", "Q32.32", "t.json"));
   s.scalar = ScalarKind::Fx32;
   EXPECT_NO_THROW(parseInputTrack(
       head + R"("commands": [{"tick": 2, "body": "ball", "command": "teleport", "value": [0, 0, 33000]}]})", "t.json",

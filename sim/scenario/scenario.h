@@ -52,6 +52,7 @@ struct ShapeSpec {
 struct BodySpec {
   std::string name;
   std::vector<ShapeSpec> parts;  ///< one for a sphere or a box; several for a compound
+  bool compound = false;         ///< written as a compound (error paths: .shape.parts[k], not .shape)
   Rational mass{1, 1};           ///< kg
   Rational3 position{Rational{0, 1}, Rational{1, 1}, Rational{0, 1}};
   std::array<Rational, 4> orientation{Rational{1, 1}, Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};  ///< w, x, y, z

@@ -373,6 +373,7 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
   const std::string sp = p + ".shape";
   r.object(sh, sp, {"type", "radius", "halfExtents", "parts"});
   if (sh.contains("type") && sh["type"] == "compound") {
+    b.compound = true;
     if (!sh.contains("parts") || !sh["parts"].is_array() || sh["parts"].empty() || sh["parts"].size() > 16)
       r.fail(sp + ".parts", "an array of 1 to 16 sphere/box parts");
     for (size_t i = 0; i < sh["parts"].size(); ++i)

@@ -33,7 +33,11 @@ void validateInputTrack(const InputTrack& track, ScalarKind scalar, const std::s
       if (!q32 || !ScalarTraits<S>::fromRational(v) || !(std::fabs(v.toDouble()) <= bound)) {
         std::ostringstream o;
         o.precision(6);
-        o << what << " within the " << name << " range (|value| <= " << bound << "), got " << v.toString();
+        // Q32.32 caps every scalar's inputs below 2^31 (float and double included).
+        if (bound < 2147483648.0)
+          o << what << " within the " << name << " range (|value| <= " << bound << "), got " << v.toString();
+        else
+          o << what << " within the input range (|value| < 2^31: inputs are recorded as Q32.32), got " << v.toString();
         throw ScenarioError(track.sourceName, path, o.str());
       }
     };
@@ -210,7 +214,7 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
       }
       for (int c = 0; c < 4; ++c) fits(b.orientation[size_t(c)], q + ".orientation[" + std::to_string(c) + "]");
       for (size_t k = 0; k < b.parts.size(); ++k) {
-        const std::string pp = b.parts.size() == 1 ? q + ".shape" : q + ".shape.parts[" + std::to_string(k) + "]";
+        const std::string pp = !b.compound ? q + ".shape" : q + ".shape.parts[" + std::to_string(k) + "]";
         fits(b.parts[k].radius, pp + ".radius");
         for (int c = 0; c < 3; ++c) {
           fits(b.parts[k].halfExtents[size_t(c)], pp + ".halfExtents[" + std::to_string(c) + "]");
@@ -225,7 +229,7 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
       // The shape must fit the coordinate range too: its bounding radius |offset| + |halfExtents|
       // is computed in S (a fixed-point norm squares each component).
       for (size_t k = 0; k < b.parts.size(); ++k) {
-        const std::string pp = b.parts.size() == 1 ? q + ".shape" : q + ".shape.parts[" + std::to_string(k) + "]";
+        const std::string pp = !b.compound ? q + ".shape" : q + ".shape.parts[" + std::to_string(k) + "]";
         const ShapeSpec& part = b.parts[k];
         double reach2 = 0, off2 = 0;
         for (int c = 0; c < 3; ++c) {
