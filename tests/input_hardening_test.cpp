@@ -152,6 +152,15 @@ TEST(ScenarioEcho, LongValuesAndKeysAreTruncatedAndEscaped) {
   // A number's own text (kept for exact parsing) is echoed bounded too.
   EXPECT_TRUE(throwsError([&] { parse(R"({"field": {"spacing": 1.)" + std::string(5000, '1') + "}}"); },
                           "$.field.spacing", "significant digits", kFile, 300));
+  // A duplicate body name is echoed bounded too.
+  const std::string name(100000, 'n');
+  EXPECT_TRUE(throwsError(
+      [&] {
+        parse(R"({"bodies": {"list": [{"name": ")" + name + R"(", "shape": {"type": "sphere", "radius": 1}},
+                                      {"name": ")" +
+              name + R"(", "shape": {"type": "sphere", "radius": 1}}]}})");
+      },
+      "$.bodies.list[1].name", "is taken", kFile, 300));
   // A control character in a value never splits the line.
   EXPECT_TRUE(throwsError([&] { parse(R"({"scalar": "fx\u000a32"})"); }, "$.scalar", "fx\\n32"));
 }

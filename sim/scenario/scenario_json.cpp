@@ -457,7 +457,7 @@ void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
       b.list.push_back(parseBody(r, l[i], q));
       for (size_t k = 0; k + 1 < b.list.size(); ++k)
         if (b.list[k].name == b.list.back().name)
-          r.fail(q + ".name", "a unique body name, '" + b.list.back().name + "' is taken");
+          r.fail(q + ".name", "a unique body name, '" + echoText(b.list.back().name) + "' is taken");
     }
   }
 }
