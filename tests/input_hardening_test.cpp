@@ -351,7 +351,7 @@ TEST(ScenarioHeightmap, SideAbove4096IsRejected) {
 TEST(ScenarioHeightmap, MemoryEstimateCountsTheTerrain) {
   const Scenario s = parse(R"({"field": {"patchesX": 6, "patchesZ": 6},
                                 "terrain": {"type": "heightmap", "file": "big.png", "cellSize": 0.01}})");
-  const uint64_t samples = 2048 * 2048;
+  const uint64_t samples = uint64_t(2048) * 2048;
   for (ScalarKind k : {ScalarKind::Fx32, ScalarKind::Fx16, ScalarKind::Float, ScalarKind::Double}) {
     EXPECT_GT(estimateWorldBytes(s, k), samples * 5) << scalarName(k);
     EXPECT_TRUE(throwsError([&] { validateForScalar(s, k, samples); }, "$.terrain.file", "memory")) << scalarName(k);

@@ -153,7 +153,15 @@ class Reader {
         std::string list;
         for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
         const std::string key = echoText(it.key());
-        fail(path + "." + key, "one of the keys {" + list + "}; unknown key '" + key + "'");
+        std::string where = path;
+        where += '.';
+        where += key;
+        std::string expected = "one of the keys {";
+        expected += list;
+        expected += "}; unknown key '";
+        expected += key;
+        expected += '\'';
+        fail(where, expected);
       }
     }
   }

@@ -97,7 +97,7 @@ uint64_t estimateWorldBytes(const Scenario& s, ScalarKind scalar) {
   // first and the last row (int64 each, twice: the constants and the schedule) and the row's
   // wind acceleration.
   const uint64_t fieldRows = (uint64_t(s.field.patchesZ) - 1 + k - 1) / k + 1;
-  const uint64_t rows = fieldRows * (4 * 8 + 3 * sz);
+  const uint64_t rows = fieldRows * (uint64_t(4 * 8) + 3 * sz);
   // A heightmap is held three times: the scenario's decoded samples, the world's heights in S
   // and the scenario copy a recording or a viewer keeps (one byte per sample each but the heights).
   const uint64_t samples =
