@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "replay/cli/cli_common.h"
+#include "replay/input_file.h"
 #include "replay/progress.h"
 #include "replay/recorder.h"
 #include "replay/scenario_files.h"
@@ -35,11 +36,10 @@ int record(const RecordOptions& o) {
     scenario = loadScenarioFile(o.scenario, &files);
     variant.applyTo(scenario);
     if (!o.inputTrack.empty()) {
-      std::ifstream in(o.inputTrack, std::ios::binary);
-      if (!in) throw ScenarioError(o.inputTrack, "$", "a readable input-track file");
-      std::stringstream text;
-      text << in.rdbuf();
-      track = parseInputTrack(text.str(), o.inputTrack, scenario);
+      std::string text, why;
+      if (!readInputFile(o.inputTrack, InputLimits::kInputTrackBytes, &text, &why))
+        throw ScenarioError(o.inputTrack, "$", why);
+      track = parseInputTrack(text, o.inputTrack, scenario);
     }
     world = makeWorld(scenario, o.threads, physicalMemoryBytes());
   } catch (const std::invalid_argument& e) {

@@ -145,7 +145,10 @@ int runScenario(const RunOptions& o) {
     std::printf("(ms/tick)\n");
   }
   if (!failure.ok) {
-    std::fprintf(stderr, "simgrass run: %s\n", failure.error.message().c_str());
+    // Name the input behind a body's fault (its file and JSON path), not only the tick.
+    const std::string cause = describeInputCause(scenario, nullptr, failure.error.tick, failure.error.body);
+    std::fprintf(stderr, "simgrass run: %s%s\n", failure.error.message().c_str(),
+                 cause.empty() ? "" : ("; " + cause).c_str());
     return 1;
   }
   return 0;

@@ -57,8 +57,9 @@ std::optional<Rational> parseDecimal(std::string_view t, std::string* error) {
   bool neg = false;
   if (i < t.size() && (t[i] == '-' || t[i] == '+')) neg = t[i++] == '-';
   I128 mant = 0;
-  int digits = 0, scale = 0;            // value = mant * 10^(-scale) * 10^pendingInt
-  int pendingInt = 0, pendingFrac = 0;  // zeros seen after the last non-zero digit
+  // Counts are int64: a text of any length (zeros included) counts exactly, nothing wraps.
+  int64_t digits = 0, scale = 0;            // value = mant * 10^(-scale) * 10^pendingInt
+  int64_t pendingInt = 0, pendingFrac = 0;  // zeros seen after the last non-zero digit
   bool any = false, dot = false;
   for (; i < t.size(); ++i) {
     const char c = t[i];
@@ -79,13 +80,17 @@ std::optional<Rational> parseDecimal(std::string_view t, std::string* error) {
     // A non-zero digit makes the zeros before it significant.
     digits += pendingInt + pendingFrac + 1;
     if (digits > kMaxDigits) return fail("a number with at most 30 significant digits");
-    for (int z = 0; z < pendingInt + pendingFrac; ++z) mant *= 10;
+    for (int64_t z = 0; z < pendingInt + pendingFrac; ++z) mant *= 10;
     scale += pendingFrac + (dot ? 1 : 0);
     pendingInt = pendingFrac = 0;
     mant = mant * 10 + (c - '0');
   }
   if (!any) return fail("a number");
-  int exp10 = 0;
+  // The exponent saturates at 10^15: far beyond any text's count of zeros (at most its length),
+  // so a saturated exponent still decides "too large" / "too small" exactly - never a dropped
+  // digit (1000...0e-100000 is 10^(zeros - 100000), not 1).
+  constexpr int64_t kExponentCap = 1000000000000000;
+  int64_t exp10 = 0;
   if (i < t.size() && (t[i] == 'e' || t[i] == 'E')) {
     ++i;
     bool eneg = false;
@@ -93,7 +98,7 @@ std::optional<Rational> parseDecimal(std::string_view t, std::string* error) {
     bool edig = false;
     for (; i < t.size() && std::isdigit(static_cast<unsigned char>(t[i])); ++i) {
       edig = true;
-      if (exp10 < 10000) exp10 = exp10 * 10 + (t[i] - '0');
+      exp10 = std::min(kExponentCap, exp10 * 10 + (t[i] - '0'));
     }
     if (!edig) return fail("a number (exponent digits after 'e')");
     if (eneg) exp10 = -exp10;
@@ -101,11 +106,11 @@ std::optional<Rational> parseDecimal(std::string_view t, std::string* error) {
   if (i != t.size()) return fail("a number");
   if (mant == 0) return Rational{0, 1};
   // value = mant * 10^e with mant of `digits` digits: 10^(digits-1+e) <= |value| < 10^(digits+e).
-  const int e = exp10 - scale + pendingInt;
+  const int64_t e = exp10 - scale + pendingInt;
   if (digits + e > 36 || digits - 1 + e < -36) return fail("a number from 1e-36 to below 1e36 in magnitude");
   if (e < -38) return fail("a number with at most 38 decimal places");
   I128 p = 1;
-  for (int k = 0; k < (e < 0 ? -e : e); ++k) p *= 10;
+  for (int64_t k = 0; k < (e < 0 ? -e : e); ++k) p *= 10;
   const I128 n = neg ? -mant : mant;
   auto r = e >= 0 ? Rational::make(n * p, 1) : Rational::make(n, p);
   if (!r && error) *error = "a number of representable size";

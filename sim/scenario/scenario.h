@@ -52,6 +52,7 @@ struct ShapeSpec {
 struct BodySpec {
   std::string name;
   std::vector<ShapeSpec> parts;  ///< one for a sphere or a box; several for a compound
+  bool compound = false;         ///< written as a compound (error paths: .shape.parts[k], not .shape)
   Rational mass{1, 1};           ///< kg
   Rational3 position{Rational{0, 1}, Rational{1, 1}, Rational{0, 1}};
   std::array<Rational, 4> orientation{Rational{1, 1}, Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};  ///< w, x, y, z
@@ -96,6 +97,9 @@ struct ScriptedCommand {
   int32_t body = 0;
   BodyCommandKind kind = BodyCommandKind::AddVelocity;
   Rational3 value{Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
+  /// Its index in the JSON array it was read from ($.script[source] or $.commands[source]): the
+  /// array is sorted by tick, so messages name this, not the position after sorting.
+  int64_t source = 0;
 };
 
 struct WindGust {
@@ -216,11 +220,13 @@ Scenario parseScenario(const std::string& text, const std::string& sourceName, c
 /// scenario's script when recording. Commands name bodies of `scenario` and use the script's
 /// schema; the camera holds each key's position until the next key.
 struct InputTrack {
+  std::string sourceName;                 ///< file name for error messages
   std::optional<int64_t> ticks;           ///< how long to record, when the track says
   std::vector<CameraKey> camera;          ///< increasing ticks
   std::vector<ScriptedCommand> commands;  ///< sorted by tick
 };
-/// Throws ScenarioError (file, JSON path, expected) like parseScenario.
+/// Throws ScenarioError (file, JSON path, expected) like parseScenario. Values are checked against
+/// scenario.scalar (validateInputTrack): apply variants to the scenario before parsing the track.
 InputTrack parseInputTrack(const std::string& text, const std::string& sourceName, const Scenario& scenario);
 
 /// The thesis meadow, embedded (identical to scenarios/thesis-meadow.json).
@@ -230,7 +236,17 @@ const std::string& defaultScenarioText();
 /// budget. Throws ScenarioError naming the offending JSON path.
 void validateForScalar(const Scenario& scenario, ScalarKind scalar, uint64_t memoryLimitBytes);
 
-/// Bytes of world state per patch and per particle for a scalar (used by the memory check).
+/// Checks every camera position and command value of an input track against a scalar: each must
+/// fit Q32.32 (inputs are recorded so) and the scalar's range, a position its coordinate range.
+/// Throws ScenarioError naming the track file and the JSON path ($.commands[i].value[c]).
+void validateInputTrack(const InputTrack& track, ScalarKind scalar);
+
+/// Bytes of world state a scenario needs with a scalar (used by the memory check): the field's
+/// patches and particles, the level-of-detail edge ring, the heightmap and its derived terrain.
 uint64_t estimateWorldBytes(const Scenario& scenario, ScalarKind scalar);
+
+/// The largest heightmap side accepted (samples along x or z): a 4096 x 4096 heightmap is 16 M
+/// samples. Checked by parseScenario right after the PNG is decoded (docs/scenario-format.md).
+inline constexpr int kMaxHeightmapSide = 4096;
 
 }  // namespace sg

@@ -8,13 +8,16 @@
 #include <set>
 #include <sstream>
 
+#include "sim/scenario/json_bounds.h"
 #include "sim/scenario/scenario.h"
 
 namespace sg {
 namespace {
 using json = nlohmann::json;
 
-// Records the raw text of every non-integer number by JSON path, and rejects duplicate keys.
+// Records the raw text of every non-integer number by JSON path, rejects duplicate keys and
+// refuses nesting deeper than kMaxJsonDepth before any DOM exists (json_bounds.h: a deep DOM is
+// harmless, but every recursive walk of it - json::dump in an error message - overflows the stack).
 class RawNumberCollector : public nlohmann::json_sax<json> {
  public:
   std::map<std::string, std::string> raw;
@@ -24,16 +27,16 @@ class RawNumberCollector : public nlohmann::json_sax<json> {
   bool boolean(bool) override { return after(); }
   bool number_integer(number_integer_t) override { return after(); }
   bool number_unsigned(number_unsigned_t) override { return after(); }
-  bool number_float(number_float_t, const string_t& s) override {
-    raw[path()] = s;
+  bool number_float(number_float_t v, const string_t& s) override {
+    // Kept only when the double's shortest text (what Reader::number falls back to) is not the
+    // same exact value: "0.5" or "1e-3" need no entry, so a 16 MiB array of short numbers costs
+    // no per-number path string and map node (it cost ~700 MB before; now the DOM's share).
+    if (!sameExactValue(s, json(v).dump())) raw[path()] = s;
     return after();
   }
   bool string(string_t&) override { return after(); }
   bool binary(binary_t&) override { return after(); }
-  bool start_object(std::size_t) override {
-    frames_.push_back(Frame{false, {}, 0, {}});
-    return true;
-  }
+  bool start_object(std::size_t) override { return open(false); }
   bool key(string_t& k) override {
     Frame& f = frames_.back();
     if (!f.keys.insert(k).second && duplicatePath.empty()) {
@@ -47,10 +50,7 @@ class RawNumberCollector : public nlohmann::json_sax<json> {
     frames_.pop_back();
     return after();
   }
-  bool start_array(std::size_t) override {
-    frames_.push_back(Frame{true, {}, 0, {}});
-    return true;
-  }
+  bool start_array(std::size_t) override { return open(true); }
   bool end_array() override {
     frames_.pop_back();
     return after();
@@ -65,6 +65,7 @@ class RawNumberCollector : public nlohmann::json_sax<json> {
   std::size_t errorByte = 0;
   std::string errorToken, errorPath;
   bool numberOverflow = false;
+  std::string tooDeepPath;  ///< set when nesting exceeded kMaxJsonDepth: the path of the container holding it
 
  private:
   struct Frame {
@@ -74,6 +75,14 @@ class RawNumberCollector : public nlohmann::json_sax<json> {
     std::set<std::string> keys;
   };
   std::vector<Frame> frames_;
+  bool open(bool array) {
+    if (frames_.size() >= size_t(kMaxJsonDepth)) {
+      tooDeepPath = path();
+      return false;  // stops the parse: nothing deeper is ever read
+    }
+    frames_.push_back(Frame{array, {}, 0, {}});
+    return true;
+  }
   std::string path() const {
     std::string p = "$";
     // Appended piece by piece: `"[" + std::string&&` trips GCC 12's -Wrestrict false positive (PR105329).
@@ -84,10 +93,15 @@ class RawNumberCollector : public nlohmann::json_sax<json> {
         p += ']';
       } else {
         p += '.';
-        p += f.key;
+        p += echoText(f.key);  // a key in a message is bounded and has no control characters
       }
     }
     return p;
+  }
+  static bool sameExactValue(const std::string& text, const std::string& shortest) {
+    if (text == shortest) return true;
+    const auto a = Rational::parse(text, nullptr), b = Rational::parse(shortest, nullptr);
+    return a && b && *a == *b;
   }
   bool after() {
     if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
@@ -116,12 +130,6 @@ const char* typeName(const json& j) {
   }
 }
 
-std::string show(const json& j) {
-  std::string s = j.dump();
-  if (s.size() > 40) s = s.substr(0, 37) + "...";
-  return s;
-}
-
 class Reader {
  public:
   Reader(std::string file, const std::map<std::string, std::string>& raw) : file_(std::move(file)), raw_(raw) {}
@@ -132,7 +140,7 @@ class Reader {
   [[noreturn]] void failGot(const std::string& path, const std::string& expected, const json& got) const {
     // Show a number as the user wrote it, not as the double it parsed to.
     const auto raw = got.is_number_float() ? raw_.find(path) : raw_.end();
-    fail(path, expected + ", got " + (raw != raw_.end() ? raw->second : show(got)));
+    fail(path, expected + ", got " + (raw != raw_.end() ? echoText(raw->second) : echoValue(got)));
   }
 
   /// Checks that j is an object whose keys are all in `allowed`.
@@ -144,7 +152,16 @@ class Reader {
       if (!ok) {
         std::string list;
         for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-        fail(path + "." + it.key(), "one of the keys {" + list + "}; unknown key '" + it.key() + "'");
+        const std::string key = echoText(it.key());
+        std::string where = path;
+        where += '.';
+        where += key;
+        std::string expected = "one of the keys {";
+        expected += list;
+        expected += "}; unknown key '";
+        expected += key;
+        expected += '\'';
+        fail(where, expected);
       }
     }
   }
@@ -163,7 +180,7 @@ class Reader {
     }
     std::string why;
     auto r = Rational::parse(text, &why);
-    if (!r) fail(path, why + ", got " + text);
+    if (!r) fail(path, why + ", got " + echoText(text));
     return *r;
   }
   Rational positive(const json& j, const std::string& path) const {
@@ -309,7 +326,25 @@ void parseTerrain(const Reader& r, const json& j, Scenario::Terrain& t, const Sc
   std::vector<uint8_t> bytes;
   std::string why;
   if (!readFile || !readFile(t.heightmapPath, &bytes, &why)) r.fail(p + ".file", why.empty() ? "a readable file" : why);
-  if (!decodeHeightmapPng(bytes, &t.heightmap, &why)) r.fail(p + ".file", "'" + t.heightmapPath + "' to be " + why);
+  // The size cap is checked on the PNG header before decoding (a 16384 x 16384 image would
+  // allocate 256 MiB first) and again on the decoded image (whatever the decoder).
+  const std::string name = "'" + echoText(t.heightmapPath) + "'";
+  auto tooLarge = [&](uint64_t w, uint64_t h) {
+    if (w > uint64_t(kMaxHeightmapSide) || h > uint64_t(kMaxHeightmapSide))
+      r.fail(p + ".file", name + " to be a heightmap of at most " + std::to_string(kMaxHeightmapSide) + " x " +
+                              std::to_string(kMaxHeightmapSide) + " samples, got " + std::to_string(w) + " x " +
+                              std::to_string(h));
+  };
+  static constexpr uint8_t kPngSignatureAndIhdr[16] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n',
+                                                       0,    0,   0,   13,  'I',  'H',  'D',  'R'};
+  if (bytes.size() >= 24 && std::equal(bytes.begin(), bytes.begin() + 16, kPngSignatureAndIhdr)) {
+    auto be32 = [&](size_t at) {
+      return uint64_t(bytes[at]) << 24 | uint64_t(bytes[at + 1]) << 16 | uint64_t(bytes[at + 2]) << 8 | bytes[at + 3];
+    };
+    tooLarge(be32(16), be32(20));
+  }
+  if (!decodeHeightmapPng(bytes, &t.heightmap, &why)) r.fail(p + ".file", name + " to be " + why);
+  tooLarge(uint64_t(t.heightmap.width), uint64_t(t.heightmap.height));
 }
 
 ShapeSpec parseShapePart(const Reader& r, const json& j, const std::string& p, bool allowOffset) {
@@ -346,6 +381,7 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
   const std::string sp = p + ".shape";
   r.object(sh, sp, {"type", "radius", "halfExtents", "parts"});
   if (sh.contains("type") && sh["type"] == "compound") {
+    b.compound = true;
     if (!sh.contains("parts") || !sh["parts"].is_array() || sh["parts"].empty() || sh["parts"].size() > 16)
       r.fail(sp + ".parts", "an array of 1 to 16 sphere/box parts");
     for (size_t i = 0; i < sh["parts"].size(); ++i)
@@ -358,9 +394,16 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
   if (j.contains("position")) b.position = r.vector<3>(j["position"], p + ".position");
   if (j.contains("orientation")) {
     b.orientation = r.vector<4>(j["orientation"], p + ".orientation");
-    bool nonZero = false;
-    for (const Rational& q : b.orientation) nonZero = nonZero || q.num != 0;
-    if (!nonZero) r.failGot(p + ".orientation", "a non-zero quaternion [w, x, y, z]", j["orientation"]);
+    // A unit quaternion, to within 1e-3 in its squared norm (so that 4-digit decimals such as
+    // [0.7071, 0, 0.7071, 0] pass); the world normalises it in the scalar (makeBody). A zero or a
+    // clearly non-unit quaternion is a mistake, not a rotation. Checked exactly, in rationals.
+    std::optional<Rational> norm2 = Rational{0, 1};
+    for (const Rational& q : b.orientation)
+      if (norm2) norm2 = add(*norm2, mul(q, q).value_or(Rational{1000, 1}));
+    const bool unit = norm2 && compare(*norm2, Rational{999, 1000}) >= 0 && compare(*norm2, Rational{1001, 1000}) <= 0;
+    if (!unit)
+      r.failGot(p + ".orientation", "a unit quaternion [w, x, y, z] (w^2 + x^2 + y^2 + z^2 = 1 within 0.001)",
+                j["orientation"]);
   }
   if (j.contains("velocity")) b.velocity = r.vector<3>(j["velocity"], p + ".velocity");
   if (j.contains("angularVelocity")) b.angularVelocity = r.vector<3>(j["angularVelocity"], p + ".angularVelocity");
@@ -422,7 +465,7 @@ void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
       b.list.push_back(parseBody(r, l[i], q));
       for (size_t k = 0; k + 1 < b.list.size(); ++k)
         if (b.list[k].name == b.list.back().name)
-          r.fail(q + ".name", "a unique body name, '" + b.list.back().name + "' is taken");
+          r.fail(q + ".name", "a unique body name, '" + echoText(b.list.back().name) + "' is taken");
     }
   }
 }
@@ -493,6 +536,7 @@ void parseScript(const Reader& r, const json& j, const Scenario& s, const std::s
     const json& c = j[i];
     r.object(c, q, {"tick", "body", "command", "value"});
     ScriptedCommand cmd;
+    cmd.source = int64_t(i);
     if (!c.contains("tick")) r.fail(q + ".tick", "the tick the command applies to (missing)");
     cmd.tick = r.integer(c["tick"], q + ".tick", 0, int64_t(1) << 40);
     if (!c.contains("body")) r.fail(q + ".body", "a body name or index (missing)");
@@ -567,6 +611,13 @@ json loadJson(const std::string& text, const std::string& sourceName, std::map<s
   // The SAX pass first: it knows the JSON path of a number that overflows a double.
   RawNumberCollector collector;
   const bool wellFormed = json::sax_parse(text, &collector);
+  if (!wellFormed && !collector.tooDeepPath.empty()) {
+    const size_t byte = findExcessNesting(text).value_or(0);
+    throw ScenarioError(sourceName, collector.tooDeepPath,
+                        "arrays and objects nested at most " + std::to_string(kMaxJsonDepth) + " deep, level " +
+                            std::to_string(kMaxJsonDepth + 1) + " opens at byte " + std::to_string(byte + 1) + " (" +
+                            lineColumn(text, byte) + ")");
+  }
   if (!wellFormed && collector.numberOverflow)
     throw ScenarioError(sourceName, collector.errorPath,
                         "a number from 1e-36 to below 1e36 in magnitude, got " + collector.errorToken);
@@ -681,12 +732,14 @@ InputTrack parseInputTrack(const std::string& text, const std::string& sourceNam
   const json root = loadJson(text, sourceName, &raw);
   Reader r(sourceName, raw);
   InputTrack track;
+  track.sourceName = sourceName;
   r.object(root, "$", {"format", "ticks", "camera", "commands"});
   if (!root.contains("format") || root["format"] != "simgrass-input-track/1")
     r.failGot("$.format", "\"simgrass-input-track/1\"", root.contains("format") ? root["format"] : json());
   if (root.contains("ticks")) track.ticks = r.integer(root["ticks"], "$.ticks", 0, int64_t(1) << 40);
   if (root.contains("camera")) parseCamera(r, root["camera"], "$.camera", track.camera);
   if (root.contains("commands")) parseScript(r, root["commands"], scenario, "$.commands", track.commands);
+  validateInputTrack(track, scenario.scalar);
   return track;
 }
 

@@ -18,6 +18,47 @@ std::string metres(double v) {
 }
 
 template <class S>
+void checkResolution(const Scenario& s);
+
+/// The body of validateInputTrack, for an input track ($.commands) or a scenario ($.script).
+void validateInputTrack(const InputTrack& track, ScalarKind scalar, const std::string& commandsPath) {
+  dispatchScalar(scalar, [&]<class S>() {
+    const double limit = ScalarTraits<S>::maxCoordinate;
+    const char* name = scalarName(ScalarTraits<S>::kind);
+    // Inputs are recorded as Q32.32 (tick_input.h) and rounded into S on use: a value must fit
+    // both, or it would saturate (Q32.32) or fault in the step (inputScalar).
+    auto fits = [&](const Rational& v, const std::string& path, double bound, const char* what) {
+      const auto raw = v.toScaledInteger(32);
+      const bool q32 = raw && *raw <= Int128(INT64_MAX) && *raw >= Int128(INT64_MIN);
+      if (!q32 || !ScalarTraits<S>::fromRational(v) || !(std::fabs(v.toDouble()) <= bound)) {
+        std::ostringstream o;
+        o.precision(6);
+        // Q32.32 caps every scalar's inputs below 2^31 (float and double included).
+        if (bound < 2147483648.0)
+          o << what << " within the " << name << " range (|value| <= " << bound << "), got " << v.toString();
+        else
+          o << what << " within the input range (|value| < 2^31: inputs are recorded as Q32.32), got " << v.toString();
+        throw ScenarioError(track.sourceName, path, o.str());
+      }
+    };
+    for (size_t i = 0; i < track.camera.size(); ++i)
+      for (int c = 0; c < 3; ++c)
+        fits(track.camera[i].position[size_t(c)],
+             "$.camera[" + std::to_string(i) + "].position[" + std::to_string(c) + "]", limit, "a camera coordinate");
+    for (const ScriptedCommand& cmd : track.commands) {
+      // Positions (displace, teleport, spawn) stay in the coordinate range; velocities and
+      // impulses in it too (a velocity beyond it leaves the range within a second).
+      const char* what = cmd.kind == BodyCommandKind::Teleport || cmd.kind == BodyCommandKind::Spawn ? "a position"
+                         : cmd.kind == BodyCommandKind::Displace                                     ? "a displacement"
+                                                                                                     : "a value";
+      for (int c = 0; c < 3; ++c)
+        fits(cmd.value[size_t(c)],
+             commandsPath + "[" + std::to_string(cmd.source) + "].value[" + std::to_string(c) + "]", limit, what);
+    }
+  });
+}
+
+template <class S>
 void checkResolution(const Scenario& s) {
   using T = ScalarTraits<S>;
   auto nonZero = [&](const Rational& r, const char* path, const char* what) {
@@ -52,7 +93,17 @@ uint64_t estimateWorldBytes(const Scenario& s, ScalarKind scalar) {
   }
   const uint64_t perPatch = 3 * sz + 3 + 3 * sz + 1;  // root, rotation+variant, derived
   const uint64_t perParticle = 9 * sz + 3 * sz;       // p, v, anchor, displacement
-  return nx * nz * perPatch + px * pz * perParticle + ring;
+  // Per particle row of the whole field (not only the window): the gust front's delays from the
+  // first and the last row (int64 each, twice: the constants and the schedule) and the row's
+  // wind acceleration.
+  const uint64_t fieldRows = (uint64_t(s.field.patchesZ) - 1 + k - 1) / k + 1;
+  const uint64_t rows = fieldRows * (uint64_t(4 * 8) + 3 * sz);
+  // A heightmap is held three times: the scenario's decoded samples, the world's heights in S
+  // and the scenario copy a recording or a viewer keeps (one byte per sample each but the heights).
+  const uint64_t samples =
+      s.terrain.flat ? 0 : uint64_t(s.terrain.heightmap.width) * uint64_t(s.terrain.heightmap.height);
+  const uint64_t terrain = samples * (2 + sz);
+  return nx * nz * perPatch + px * pz * perParticle + ring + rows + terrain;
 }
 
 void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimitBytes) {
@@ -61,9 +112,20 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
   if (memoryLimitBytes != 0 && bytes > memoryLimitBytes) {
     std::ostringstream o;
     o.precision(3);
-    o << "a field that fits in memory: " << s.field.patchesX << " x " << s.field.patchesZ << " patches need "
-      << double(bytes) / (1 << 30) << " GiB, the limit is " << double(memoryLimitBytes) / (1 << 30) << " GiB";
-    throw ScenarioError(s.sourceName, "$.field", o.str());
+    const bool heightmap = !s.terrain.flat;
+    o << "a " << (heightmap ? "field and heightmap" : "field") << " that fit in memory: " << s.field.patchesX << " x "
+      << s.field.patchesZ << " patches";
+    if (heightmap) o << " and " << s.terrain.heightmap.width << " x " << s.terrain.heightmap.height << " samples";
+    o << " need " << double(bytes) / (1 << 30) << " GiB, the limit is " << double(memoryLimitBytes) / (1 << 30)
+      << " GiB";
+    // Blame the bigger of the two: the heightmap when it alone is over half the estimate.
+    Scenario flat;
+    flat.field = s.field;
+    flat.particles = s.particles;
+    flat.lod = s.lod;
+    const uint64_t fieldBytes = estimateWorldBytes(flat, scalar);
+    throw ScenarioError(s.sourceName, heightmap && bytes - fieldBytes > fieldBytes ? "$.terrain.file" : "$.field",
+                        o.str());
   }
   // Every exact constant the world will use (throws with a path if one cannot be formed).
   const ScenarioConstants derived = deriveConstants(s);
@@ -152,7 +214,7 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
       }
       for (int c = 0; c < 4; ++c) fits(b.orientation[size_t(c)], q + ".orientation[" + std::to_string(c) + "]");
       for (size_t k = 0; k < b.parts.size(); ++k) {
-        const std::string pp = b.parts.size() == 1 ? q + ".shape" : q + ".shape.parts[" + std::to_string(k) + "]";
+        const std::string pp = !b.compound ? q + ".shape" : q + ".shape.parts[" + std::to_string(k) + "]";
         fits(b.parts[k].radius, pp + ".radius");
         for (int c = 0; c < 3; ++c) {
           fits(b.parts[k].halfExtents[size_t(c)], pp + ".halfExtents[" + std::to_string(c) + "]");
@@ -160,6 +222,34 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
         }
       }
       fits(b.mass, q + ".mass");
+      fits(b.friction, q + ".friction");
+      fits(b.restitution, q + ".restitution");
+      fits(b.linearDamping, q + ".linearDamping");
+      fits(b.angularDamping, q + ".angularDamping");
+      // The shape must fit the coordinate range too: its bounding radius |offset| + |halfExtents|
+      // is computed in S (a fixed-point norm squares each component).
+      for (size_t k = 0; k < b.parts.size(); ++k) {
+        const std::string pp = !b.compound ? q + ".shape" : q + ".shape.parts[" + std::to_string(k) + "]";
+        const ShapeSpec& part = b.parts[k];
+        double reach2 = 0, off2 = 0;
+        for (int c = 0; c < 3; ++c) {
+          const double h =
+              part.type == ShapeType::Sphere ? (c == 0 ? d(part.radius) : 0) : d(part.halfExtents[size_t(c)]);
+          reach2 += h * h;
+          off2 += d(part.offset[size_t(c)]) * d(part.offset[size_t(c)]);
+        }
+        check(std::sqrt(reach2), (pp + (part.type == ShapeType::Sphere ? ".radius" : ".halfExtents")).c_str(),
+              "a body part whose size");
+        check(std::sqrt(off2), (pp + ".offset").c_str(), "a body part offset whose length");
+        // Squares of sizes are formed in S (norm(), contact distances, sums of two): keep them
+        // within a quarter of the range like coordinates (fixed point only).
+        if (ScalarTraits<S>::isFixed && !(std::max(reach2, off2) <= limit))
+          throw ScenarioError(s.sourceName, pp,
+                              std::string("a body part whose squared size and offset fit ") +
+                                  scalarName(ScalarTraits<S>::kind) +
+                                  " (|size|^2 <= " + metres(limit).substr(0, metres(limit).size() - 2) + ")");
+      }
+      takeFixedFaults();
       try {
         (void)makeBody<S>(b, s.timeStep, s.sourceName, q);
       } catch (const std::out_of_range&) {
@@ -167,16 +257,38 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
                             std::string("mass properties (1/mass, 1/inertia) within the ") +
                                 scalarName(ScalarTraits<S>::kind) + " range");
       }
+      if (takeFixedFaults() != 0)
+        throw ScenarioError(s.sourceName, q + ".shape",
+                            std::string("a body whose shape and mass properties fit the ") +
+                                scalarName(ScalarTraits<S>::kind) + " range");
+    }
+    // Everything else the world converts (world.cpp toS): no value may reach a throwing conversion.
+    fits(s.bodies.mowerCutHeight, "$.bodies.mowerCutHeight");
+    fits(s.bodies.grassDrag, "$.bodies.grassDrag");
+    fits(derived.invParticleSpacing, "$.field.spacing");
+    fits(derived.dampingPerTick, "$.particles.damping");
+    if (s.markings.enabled) {
+      const auto& m = s.markings;
+      check(std::fabs(d(m.centerX)), "$.markings.center[0]", "a markings centre");
+      check(std::fabs(d(m.centerZ)), "$.markings.center[1]", "a markings centre");
+      check(d(m.length), "$.markings.length", "a markings length");
+      check(d(m.width), "$.markings.width", "a markings width");
+      check(d(m.lineWidth), "$.markings.lineWidth", "a markings line width");
+      check(d(m.centerCircleRadius), "$.markings.centerCircleRadius", "a centre circle radius");
+    }
+    if (s.lod.mode == LodMode::Window && s.lod.centerGiven) {
+      check(std::fabs(d(s.lod.centerX)), "$.lod.center[0]", "a window centre");
+      check(std::fabs(d(s.lod.centerZ)), "$.lod.center[1]", "a window centre");
     }
     checkResolution<S>(s);
   });
-  // Scripted values are recorded as Q32.32 inputs: they must fit that format.
-  for (size_t i = 0; i < s.script.size(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      const auto raw = s.script[i].value[size_t(c)].toScaledInteger(32);
-      if (!raw || *raw > Int128(INT64_MAX) || *raw < Int128(INT64_MIN))
-        throw ScenarioError(s.sourceName, "$.script[" + std::to_string(i) + "].value[" + std::to_string(c) + "]",
-                            "a value within +-2147483647 (inputs are Q32.32)");
-    }
+  // The scenario's own camera track and script are inputs like an input track's.
+  InputTrack own;
+  own.sourceName = s.sourceName;
+  own.camera = s.camera;
+  own.commands = s.script;
+  validateInputTrack(own, scalar, "$.script");
 }
+
+void validateInputTrack(const InputTrack& track, ScalarKind scalar) { validateInputTrack(track, scalar, "$.commands"); }
 }  // namespace sg

@@ -9,11 +9,19 @@
 
 namespace sg {
 
-/// raw / 2^32 rounded once into S (0 when it does not fit S: scenario and input validation keep
-/// inputs in range).
+/// raw / 2^32 rounded once into S. Scenario and input-track validation keep inputs in range; an
+/// input that still does not fit S (a recording replayed with a narrower scalar) raises a
+/// fixed-point overflow fault, which the input stage reports as a simulation error naming the
+/// body - never a silent 0. The value returned then is S's extreme of the input's sign.
 template <class S>
 S inputScalar(int64_t raw) {
-  return ScalarTraits<S>::fromRational(Rational{raw, int64_t(1) << 32}).value_or(S(0));
+  if (const auto v = ScalarTraits<S>::fromRational(Rational{raw, int64_t(1) << 32})) return *v;
+  if constexpr (ScalarTraits<S>::isFixed) {
+    detail::raiseFixedFault(kFixedFaultOverflow);
+    return raw < 0 ? S::min() : S::max();
+  } else {
+    return S(0);  // unreachable: a float or double takes every Q32.32 value
+  }
 }
 
 template <class S>

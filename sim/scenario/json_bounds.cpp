@@ -1,0 +1,144 @@
+#include "sim/scenario/json_bounds.h"
+
+#include <cstdio>
+#include <utility>
+#include <vector>
+
+namespace sg {
+namespace {
+using json = nlohmann::json;
+
+/// Cuts `s` to at most `n` bytes without splitting a UTF-8 sequence.
+size_t cutPoint(std::string_view s, size_t n) {
+  if (s.size() <= n) return s.size();
+  while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;
+  return n;
+}
+
+void appendEscaped(std::string& out, std::string_view s) {
+  for (unsigned char c : s) {
+    if (c == '\n')
+      out += "\\n";
+    else if (c == '\r')
+      out += "\\r";
+    else if (c == '\t')
+      out += "\\t";
+    else if (c < 0x20 || c == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out += char(c);
+    }
+  }
+}
+
+/// Writes a compact rendering of v into out until out holds more than `budget` bytes. Recursion
+/// is bounded by kEchoLevels (deeper containers print as [...] / {...}).
+constexpr int kEchoLevels = 8;
+void render(const json& v, std::string& out, size_t budget, int level) {
+  if (out.size() > budget) return;
+  switch (v.type()) {
+    case json::value_t::string: {
+      const auto& s = v.get_ref<const json::string_t&>();
+      out += '"';
+      appendEscaped(out, std::string_view(s).substr(0, cutPoint(s, budget + 1)));
+      if (s.size() <= budget) out += '"';
+      return;
+    }
+    case json::value_t::array:
+    case json::value_t::object: {
+      const bool array = v.is_array();
+      if (level >= kEchoLevels) {
+        out += array ? "[...]" : "{...}";
+        return;
+      }
+      out += array ? '[' : '{';
+      bool first = true;
+      for (auto it = v.begin(); it != v.end(); ++it) {
+        if (out.size() > budget) return;
+        if (!first) out += ',';
+        first = false;
+        if (!array) {
+          out += '"';
+          appendEscaped(out, std::string_view(it.key()).substr(0, cutPoint(it.key(), budget + 1)));
+          out += "\":";
+        }
+        render(*it, out, budget, level + 1);
+      }
+      out += array ? ']' : '}';
+      return;
+    }
+    case json::value_t::binary:
+      out += "<binary>";
+      return;
+    case json::value_t::discarded:
+      out += "<discarded>";
+      return;
+    default:
+      out += v.dump();  // a number, a boolean or null: a short token
+      return;
+  }
+}
+}  // namespace
+
+std::optional<size_t> findExcessNesting(std::string_view text, int maxDepth) {
+  int depth = 0;
+  bool inString = false, escaped = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (inString) {
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        inString = false;
+      continue;
+    }
+    if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > maxDepth) return i;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return std::nullopt;
+}
+
+int jsonDepth(const json& value, int limit) {
+  // Depth-first with an explicit stack of (value, depth): no recursion.
+  int deepest = 0;
+  std::vector<std::pair<const json*, int>> stack{{&value, 0}};
+  while (!stack.empty()) {
+    const auto [v, d] = stack.back();
+    stack.pop_back();
+    if (!v->is_structured()) continue;
+    if (d + 1 > deepest) deepest = d + 1;
+    if (deepest > limit) return limit + 1;
+    for (const json& child : *v)
+      if (child.is_structured()) stack.emplace_back(&child, d + 1);
+  }
+  return deepest;
+}
+
+std::string echoText(std::string_view text, size_t maxChars) {
+  std::string out;
+  const size_t n = cutPoint(text, maxChars);
+  appendEscaped(out, text.substr(0, n));
+  if (n < text.size()) out += "...";
+  return out;
+}
+
+std::string echoValue(const json& value, size_t maxChars) {
+  std::string out;
+  render(value, out, maxChars, 0);
+  if (out.size() > maxChars) {
+    out.resize(cutPoint(out, maxChars));
+    out += "...";
+  }
+  return out;
+}
+
+}  // namespace sg
