@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <string>
 
+#include "sim/scenario/json_bounds.h"
+
 namespace sg::viewer {
 
 /// A 64-bit hash as 16 hex digits (how the CLI prints state hashes).
@@ -26,64 +28,21 @@ namespace sg::viewer {
 
 /// Bounds on what a user edits in the viewer (`set`, panels; docs/viewer.md "Limits").
 struct EditLimits {
-  static constexpr int kJsonDepth = 64;                     ///< nesting of a `set` value (and the edited path)
+  static constexpr int kJsonDepth = kMaxJsonDepth;                   ///< nesting of a `set` value (and the edited path)
   static constexpr size_t kPathSegments = 16;               ///< segments of a `set` path ("a.b.c")
   static constexpr size_t kPathChars = 256;                 ///< length of a `set` path
   static constexpr size_t kArrayEntries = size_t(1) << 16;  ///< entries an edited array may grow to
-  static constexpr size_t kShownChars = 60;                 ///< echoed user text in messages
+  static constexpr size_t kShownChars = kEchoChars;               ///< echoed user text in messages
 };
 
-/// User text quoted in a one-line message: control characters escaped (\n, \x01), at most `max`
-/// characters of the original shown, then "..." (so no input can make a message long or multi-line).
-inline std::string shownText(const std::string& s, size_t max = EditLimits::kShownChars) {
-  std::string out;
-  const size_t n = std::min(s.size(), max);
-  for (size_t i = 0; i < n; ++i) {
-    const unsigned char c = static_cast<unsigned char>(s[i]);
-    if (c == '\n')
-      out += "\\n";
-    else if (c == '\r')
-      out += "\\r";
-    else if (c == '\t')
-      out += "\\t";
-    else if (c < 0x20 || c == 0x7f) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += buf;
-    } else {
-      out += char(c);
-    }
-  }
-  if (s.size() > max) out += "...";
-  return out;
-}
+/// User text quoted in a one-line message (sim/scenario/json_bounds.h echoText: control
+/// characters escaped, at most `max` characters, then "...").
+inline std::string shownText(const std::string& s, size_t max = EditLimits::kShownChars) { return echoText(s, max); }
 
-/// The deepest nesting of arrays and objects in JSON text (brackets inside strings do not count),
-/// found without parsing: a value 100000 levels deep is refused before any recursive code (the
-/// parser's result, its dump, its destructor) sees it. Stops counting once past `limit`.
+/// The deepest nesting of arrays and objects in JSON text, found without parsing (brackets inside
+/// strings do not count): past `limit` it returns a value above `limit`.
 inline int jsonNestingDepth(const std::string& text, int limit) {
-  int depth = 0, deepest = 0;
-  bool inString = false, escaped = false;
-  for (char c : text) {
-    if (inString) {
-      if (escaped)
-        escaped = false;
-      else if (c == '\\')
-        escaped = true;
-      else if (c == '"')
-        inString = false;
-      continue;
-    }
-    if (c == '"') {
-      inString = true;
-    } else if (c == '[' || c == '{') {
-      deepest = std::max(deepest, ++depth);
-      if (deepest > limit) return deepest;
-    } else if ((c == ']' || c == '}') && depth > 0) {
-      --depth;
-    }
-  }
-  return deepest;
+  return findExcessNesting(text, limit) ? limit + 1 : 0;
 }
 
 }  // namespace sg::viewer
