@@ -47,22 +47,22 @@ nlohmann::json headerJson(const sgr::Recording& r) {
 }
 
 int replay(const ReplayOptions& o) {
+  if (overwritesInput("replay", "--export-state", o.exportState, {o.file})) return kExitBadInput;
   std::unique_ptr<sgr::Recording> rec;
   try {
     rec = std::make_unique<sgr::Recording>(sgr::readRecording(o.file));
   } catch (const sgr::RecordingError& e) {
-    std::fprintf(stderr, "simgrass replay: %s\n", e.what());
+    printError("simgrass replay: %s\n", e.what());
     return kExitBadInput;
   }
   if (rec->truncated)
-    std::fprintf(stderr,
-                 "simgrass replay: warning: %s: byte %" PRIu64 ": expected %s; replaying the %" PRId64
-                 " ticks before it\n",
-                 o.file.c_str(), rec->truncatedAt, rec->truncatedExpected.c_str(), rec->lastTick());
+    printError("simgrass replay: warning: %s: byte %" PRIu64 ": expected %s; replaying the %" PRId64
+               " ticks before it\n",
+               o.file.c_str(), rec->truncatedAt, rec->truncatedExpected.c_str(), rec->lastTick());
   nlohmann::json out = headerJson(*rec);
   if (o.info) {
     if (o.json) {
-      std::printf("%s\n", out.dump(2).c_str());
+      std::printf("%s\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
     } else {
       std::printf("recording  %s (%s)\n", o.file.c_str(), rec->end ? "complete" : "cut off before END");
       std::printf("scenario   %s, %s\n", rec->header.scenarioSource.c_str(), rec->header.variant.c_str());
@@ -78,15 +78,14 @@ int replay(const ReplayOptions& o) {
   try {
     player = std::make_unique<Player>(*rec, o.threads);
   } catch (const sgr::RecordingError& e) {
-    std::fprintf(stderr, "simgrass replay: %s\n", e.what());
+    printError("simgrass replay: %s\n", e.what());
     return kExitBadInput;
   }
   const int64_t last = rec->lastTick();
   if (o.to > last) {
-    std::fprintf(stderr,
-                 "simgrass replay: --to: expected a tick from %" PRId64 " to %" PRId64
-                 " (the recording's last), got %" PRId64 "\n",
-                 rec->header.startTick, last, o.to);
+    printError("simgrass replay: --to: expected a tick from %" PRId64 " to %" PRId64
+               " (the recording's last), got %" PRId64 "\n",
+               rec->header.startTick, last, o.to);
     return kExitBadInput;
   }
   int code = kExitOk;
@@ -103,13 +102,13 @@ int replay(const ReplayOptions& o) {
         out["firstMismatchTick"] = v.firstMismatchTick;
         if (v.fault) {
           out["error"] = v.fault->message();
-          std::fprintf(stderr, "simgrass replay: %s: the replay faulted where the recording did not: %s\n",
-                       o.file.c_str(), v.fault->message().c_str());
+          printError("simgrass replay: %s: the replay faulted where the recording did not: %s\n", o.file.c_str(),
+                     v.fault->message().c_str());
         } else {
           out["expectedHash"] = hex(v.expectedHash);
           out["actualHash"] = hex(v.actualHash);
-          std::fprintf(stderr, "simgrass replay: %s: hash mismatch at tick %" PRId64 ": recorded %s, replayed %s\n",
-                       o.file.c_str(), v.firstMismatchTick, hex(v.expectedHash).c_str(), hex(v.actualHash).c_str());
+          printError("simgrass replay: %s: hash mismatch at tick %" PRId64 ": recorded %s, replayed %s\n",
+                     o.file.c_str(), v.firstMismatchTick, hex(v.expectedHash).c_str(), hex(v.actualHash).c_str());
         }
         code = kExitMismatch;
       } else if (!o.json) {
@@ -122,13 +121,13 @@ int replay(const ReplayOptions& o) {
       const StepResult r = player->seek(target, [&bar](int64_t done) { bar.update(done); });
       bar.finish();
       if (!r.ok) {
-        std::fprintf(stderr, "simgrass replay: %s\n", r.error.message().c_str());
+        printError("simgrass replay: %s\n", r.error.message().c_str());
         out["error"] = r.error.message();
         code = kExitMismatch;
       }
     }
   } catch (const sgr::RecordingError& e) {
-    std::fprintf(stderr, "simgrass replay: %s\n", e.what());
+    printError("simgrass replay: %s\n", e.what());
     return kExitBadInput;
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -140,8 +139,8 @@ int replay(const ReplayOptions& o) {
   out["seconds"] = seconds;
   if (expected) out["matchesRecording"] = *expected == hash;
   if (code == kExitOk && expected && *expected != hash) {
-    std::fprintf(stderr, "simgrass replay: %s: hash at tick %" PRId64 " is %s, the recording has %s\n", o.file.c_str(),
-                 tick, hex(hash).c_str(), hex(*expected).c_str());
+    printError("simgrass replay: %s: hash at tick %" PRId64 " is %s, the recording has %s\n", o.file.c_str(), tick,
+               hex(hash).c_str(), hex(*expected).c_str());
     code = kExitMismatch;
   }
   if (!o.exportState.empty()) {
@@ -157,13 +156,13 @@ int replay(const ReplayOptions& o) {
       written = writeFileAtomic(o.exportState, player->world().saveState(), &error);
     }
     if (!written) {
-      std::fprintf(stderr, "simgrass replay: %s\n", error.c_str());
+      printError("simgrass replay: %s\n", error.c_str());
       return kExitBadInput;
     }
     out["exportedState"] = o.exportState;
   }
   if (o.json) {
-    std::printf("%s\n", out.dump(2).c_str());
+    std::printf("%s\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   } else {
     std::printf("tick %" PRId64 " hash %s%s\n", tick, hex(hash).c_str(),
                 expected ? (*expected == hash ? " (matches the recording)" : " (DIFFERS from the recording)") : "");
