@@ -26,6 +26,7 @@
 #include "replay/format/sgr_reader.h"
 #include "replay/format/sgr_writer.h"
 #include "replay/player.h"
+#include "replay/recording.h"
 #include "sim/state/byte_order.h"
 #include "tests/cli_support.h"
 #include "tests/test_support.h"
@@ -497,6 +498,24 @@ TEST(RecordingLimits, RecordRefusesALongRecordingWithoutHashesOrSnapshots) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+TEST(RecordingLimits, TheRecorderRefusesAStepTheReaderCouldNotReach) {
+  // Through the public facade: no hashes, no snapshots, so only the script's inputs (ticks 3 and
+  // 13) name ticks; the step that would end kMaxTickGap + 1 ticks after tick 13 is refused, and
+  // what was recorded still reads and verifies.
+  TempDir dir;
+  const std::string out = dir.file("sparse.sgr");
+  RecordingSettings settings;
+  settings.checkEvery = 0;
+  settings.snapshotEvery = 0;
+  RecordingSession session = RecordingSession::fromScenarioFile(tinyScenario(), out, settings);
+  EXPECT_TRUE(session.stepScripted(13 + sgr::kMaxTickGap));
+  EXPECT_THROW(session.stepScripted(1), std::runtime_error);
+  EXPECT_EQ(session.finish().ticks, 13 + sgr::kMaxTickGap);
+  const VerifyResult v = verifyRecording(out);
+  EXPECT_TRUE(v.ok) << v.error;
+  EXPECT_EQ(v.ticks, 13 + sgr::kMaxTickGap);
+}
+
 // ---- 7. outputs: complete or absent, every write checked ---------------------------------------
 
 TEST(RecordingLimits, AFullDiskIsOneLineForEveryOutputAndLeavesNoPartialFile) {
@@ -530,7 +549,7 @@ TEST(RecordingLimits, ARecordingCutByAFullDiskIsOneLineAndReadsUpToTheCut) {
   const std::string out = dir.file("full.sgr");
   const CliResult r = runShell("ulimit -f 8; exec " + cli() + " record " + quote(tinyScenario()) + " -o " + quote(out) +
                                " --ticks 600");
-  EXPECT_EQ(r.exitCode, kExitMismatch) << r.describe();
+  EXPECT_EQ(r.exitCode, kExitBadInput) << r.describe();
   EXPECT_TRUE(isOneLine(r.err)) << r.describe();
   EXPECT_TRUE(contains(r.err, out + ": cannot write the recording")) << r.describe();
   const sgr::Recording rec = sgr::readRecording(out);  // everything before the failed write
@@ -544,6 +563,41 @@ TEST(RecordingLimits, AStandardOutputThatCannotBeWrittenIsAFailedCommand) {
   EXPECT_EQ(r.exitCode, kExitBadInput) << r.describe();
   EXPECT_TRUE(isOneLine(r.err)) << r.describe();
   EXPECT_TRUE(contains(r.err, "simgrass replay: standard output: cannot write")) << r.describe();
+}
+
+TEST(RecordingLimits, RecordToAFifoIsRefusedWithoutWaitingForAReader) {
+  TempDir dir;
+  const std::string fifo = dir.file("out.sgr");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  const CliResult r = runCli("record " + quote(tinyScenario()) + " -o " + quote(fifo) + " --ticks 2");
+  EXPECT_EQ(r.exitCode, kExitBadInput) << r.describe();
+  EXPECT_TRUE(isOneLine(r.err)) << r.describe();
+  EXPECT_TRUE(contains(r.err, fifo + ": cannot create the recording")) << r.describe();
+}
+
+TEST(RecordingLimits, TwoOutputsOfOneCommandMayNotBeTheSameFile) {
+  TempDir dir;
+  const std::string a = dir.file("a.sgr"), out = dir.file("out.csv");
+  ASSERT_EQ(runCli("record " + quote(tinyScenario()) + " -o " + quote(a) + " --ticks 4").exitCode, 0);
+  for (const std::string& args :
+       {"diff " + quote(a) + " " + quote(a) + " --csv " + quote(out) + " --heatmap " + quote(out),
+        "compare " + quote(a) + " --variant interp=2 --csv " + quote(out) + " --series " + quote(out)}) {
+    const CliResult r = runCli(args);
+    SCOPED_TRACE(args);
+    EXPECT_EQ(r.exitCode, kExitBadInput) << r.describe();
+    EXPECT_TRUE(isOneLine(r.err)) << r.describe();
+    EXPECT_TRUE(contains(r.err, "expected a file other than the")) << r.describe();
+  }
+}
+
+TEST(RecordingLimits, AScenarioTextLargerThanAScenarioFileMayBeIsRefused) {
+  sgr::Header h = tinyHeader();
+  h.scenarioText = std::string(InputLimits::kScenarioBytes + 1, ' ');
+  h.scenarioHash = XXH3_64bits(h.scenarioText.data(), h.scenarioText.size());
+  EXPECT_NE(sgr::headerProblem(h), "");
+  std::vector<Chunk> chunks = chunksOf(readBytes(tinyRecording()));
+  chunks[0].payload = sgr::encodeHead(h);
+  EXPECT_TRUE(contains(parseError(assemble(chunks)).what(), "the scenario text length that fits")) << "read";
 }
 
 // ---- 8. no command overwrites its own input -----------------------------------------------------

@@ -82,6 +82,15 @@ inline bool overwritesInput(const char* command, const char* option, const std::
   return false;
 }
 
+/// True, after one line on stderr, when two output options name the same file (one would
+/// silently replace the other).
+inline bool sameOutputTwice(const char* command, const char* optionA, const std::string& a, const char* optionB,
+                            const std::string& b) {
+  if (a.empty() || b.empty() || !(a == b || sameFile(a, b))) return false;
+  printError("simgrass %s: %s %s: expected a file other than the %s output", command, optionB, b.c_str(), optionA);
+  return true;
+}
+
 /// Exit codes shared by the commands.
 enum ExitCode : int {
   kExitOk = 0,

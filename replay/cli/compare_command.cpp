@@ -59,7 +59,8 @@ struct Reference {
 
 int compare(const CompareOptions& o) {
   if (overwritesInput("compare", "--csv", o.csv, {o.file}) ||
-      overwritesInput("compare", "--series", o.series, {o.file}))
+      overwritesInput("compare", "--series", o.series, {o.file}) ||
+      sameOutputTwice("compare", "--csv", o.csv, "--series", o.series))
     return kExitBadInput;
   const std::unique_ptr<sgr::Recording> rec = loadRecordingFor("compare", o.file);
   if (!rec) return kExitBadInput;

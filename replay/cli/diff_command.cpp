@@ -89,7 +89,8 @@ int diff(const DiffOptions& o) {
   a.file = o.a, b.file = o.b;
   if (!canWrite("diff", o.csv, "CSV file") || !canWrite("diff", o.heatmap, "PNG file")) return kExitBadInput;
   if (overwritesInput("diff", "--csv", o.csv, {o.a, o.b}) ||
-      overwritesInput("diff", "--heatmap", o.heatmap, {o.a, o.b}))
+      overwritesInput("diff", "--heatmap", o.heatmap, {o.a, o.b}) ||
+      sameOutputTwice("diff", "--csv", o.csv, "--heatmap", o.heatmap))
     return kExitBadInput;
   a.rec = loadRecordingFor("diff", o.a);
   if (!a.rec) return kExitBadInput;

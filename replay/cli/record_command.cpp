@@ -117,9 +117,11 @@ int record(const RecordOptions& o) {
     }
     recorder->finish(last);
   } catch (const std::runtime_error& e) {
+    // The recording cannot be written (a full disk, a file-size limit): exit 2, as for every
+    // command's outputs; the file reads up to its last complete chunk.
     progress.finish();
     printError("simgrass record: %s\n", e.what());
-    return kExitMismatch;
+    return kExitBadInput;
   }
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

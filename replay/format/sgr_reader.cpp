@@ -209,7 +209,7 @@ void parseHead(Recording& r, Cursor& c) {
   h.variant = c.string("the variant settings", kMaxShortString);
   h.scenarioSource = c.string("the scenario file name", kMaxShortString);
   const uint64_t textAt = c.offset();
-  h.scenarioText = c.string("the scenario text", kMaxHeadPayload);
+  h.scenarioText = c.string("the scenario text", InputLimits::kScenarioBytes);  // as a scenario file
   if (XXH3_64bits(h.scenarioText.data(), h.scenarioText.size()) != h.scenarioHash)
     c.fail(textAt, "scenario text matching its hash");
   const uint64_t countAt = c.offset();

@@ -1,7 +1,9 @@
 #include "replay/format/sgr_writer.h"
+#include "replay/input_file.h"
 #include "sim/state/byte_order.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <xxhash.h>
@@ -44,6 +46,8 @@ std::string headerProblem(const Header& h) {
   if (h.scenarioSource.size() > kMaxShortString)
     return tooLong("a scenario file name", kMaxShortString, h.scenarioSource.size());
   if (h.buildId.size() > kMaxShortString) return tooLong("a build id", kMaxShortString, h.buildId.size());
+  if (h.scenarioText.size() > InputLimits::kScenarioBytes)
+    return tooLong("a scenario text", InputLimits::kScenarioBytes, h.scenarioText.size());
   if (h.files.size() > kMaxEmbeddedFiles)
     return "at most " + std::to_string(kMaxEmbeddedFiles) + " embedded files, got " + std::to_string(h.files.size());
   uint64_t total =
@@ -159,8 +163,26 @@ Writer::Writer(const std::string& path, const Header& header) : path_(path) {
   // Checked before the file is created: a recording the reader would refuse is never started.
   if (const std::string why = headerProblem(header); !why.empty())
     throw std::runtime_error(path + ": cannot record: expected " + why);
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd_ < 0) ioFail(path, "cannot create the recording");
+  // O_NONBLOCK: opening a FIFO for writing would wait for a reader for ever; it is refused below
+  // (a recording is a file to read back), as is anything but a regular file or a device.
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | O_NONBLOCK | O_NOCTTY, 0644);
+  if (fd_ < 0) {
+    if (errno == ENXIO) errno = EINVAL;  // a FIFO without a reader
+    ioFail(path, "cannot create the recording");
+  }
+  struct stat st {};
+  if (::fstat(fd_, &st) != 0 || !(S_ISREG(st.st_mode) || S_ISCHR(st.st_mode))) {
+    ::close(fd_);
+    fd_ = -1;
+    throw std::runtime_error(path + ": cannot create the recording: expected a regular file, not a FIFO or socket");
+  }
+  if (S_ISREG(st.st_mode) && ::ftruncate(fd_, 0) != 0) {
+    ::close(fd_);
+    fd_ = -1;
+    ioFail(path, "cannot create the recording");
+  }
+  const int flags = ::fcntl(fd_, F_GETFL);
+  if (flags >= 0) ::fcntl(fd_, F_SETFL, flags & ~O_NONBLOCK);
   pending_.insert(pending_.end(), std::begin(kMagic), std::end(kMagic));
   put<uint32_t>(pending_, kFormatVersion);
   append(ChunkType::Head, encodeHead(header));
