@@ -441,6 +441,27 @@ TEST(RecordingLimits, ARecordingMissingItsLastSnapshotOrItsChecksIsDamaged) {
   }
 }
 
+TEST(RecordingLimits, ARecordingThatFaultedOnItsLastInputVerifies) {
+  // The command of tick 2 makes the ball's velocity overflow in the step from tick 2: END (faulted,
+  // tick 2) follows the INPT of tick 2. Such a recording was refused as "a final tick from 3".
+  TempDir dir;
+  nlohmann::json s = nlohmann::json::parse(readFile(tinyScenario()));
+  s["script"] = {{{"tick", 2}, {"body", "ball"}, {"command", "addVelocity"}, {"value", {1e9, 1e9, 1e9}}}};
+  const std::string scenario = dir.write("fault.json", s.dump());
+  const std::string out = dir.file("fault.sgr");
+  const CliResult rec = runCli("record " + quote(scenario) + " -o " + quote(out) + " --ticks 20");
+  ASSERT_EQ(rec.exitCode, kExitMismatch) << rec.describe();
+  const sgr::Recording r = sgr::readRecording(out);
+  ASSERT_TRUE(r.end && r.end->faulted);
+  EXPECT_EQ(r.end->tick, 2);
+  EXPECT_EQ(r.inputs.back().tick, 2);
+  for (const char* how : {" --verify", " --verify --to 2", ""}) {
+    const CliResult v = runCli("replay " + quote(out) + how);
+    EXPECT_EQ(v.exitCode, kExitOk) << v.describe();
+    EXPECT_EQ(v.err, "") << v.describe();
+  }
+}
+
 // ---- 6. record refuses what replay would refuse -------------------------------------------------
 
 TEST(RecordingLimits, TheWriterRefusesAHeaderOrAnInputTheReaderWouldRefuse) {

@@ -89,6 +89,9 @@ int replay(const ReplayOptions& o) {
     return kExitBadInput;
   }
   int code = kExitOk;
+  // Verifying a recording that stopped on a fault replays the faulting step too: the world is left
+  // in that step's state, which no recorded hash describes.
+  bool inFaultedStep = false;
   const auto start = std::chrono::steady_clock::now();
   try {
     if (o.verify) {
@@ -114,8 +117,13 @@ int replay(const ReplayOptions& o) {
       } else if (!o.json) {
         std::printf("verified %" PRId64 " ticks (%" PRId64 " hashes match)\n", v.ticks, v.checksVerified);
       }
+      inFaultedStep = v.ok && rec->end && rec->end->faulted;
     }
     if (code == kExitOk && (o.to >= 0 || !o.verify)) {
+      if (inFaultedStep) {  // seek from a fresh world, not from inside the faulted step
+        player = std::make_unique<Player>(*rec, o.threads);
+        inFaultedStep = false;
+      }
       const int64_t target = o.to >= 0 ? o.to : last;
       ProgressBar bar("seek", target, !o.json);
       const StepResult r = player->seek(target, [&bar](int64_t done) { bar.update(done); });
@@ -133,7 +141,9 @@ int replay(const ReplayOptions& o) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const int64_t tick = player->tick();
   const uint64_t hash = player->world().stateHash();
-  const std::optional<uint64_t> expected = recordedHash(*rec, tick);
+  std::optional<uint64_t> expected;
+  if (!inFaultedStep) expected = recordedHash(*rec, tick);
+  if (inFaultedStep) out["recordedFault"] = rec->end->message;
   out["tick"] = tick;
   out["hash"] = hex(hash);
   out["seconds"] = seconds;
@@ -165,7 +175,9 @@ int replay(const ReplayOptions& o) {
     std::printf("%s\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   } else {
     std::printf("tick %" PRId64 " hash %s%s\n", tick, hex(hash).c_str(),
-                expected ? (*expected == hash ? " (matches the recording)" : " (DIFFERS from the recording)") : "");
+                inFaultedStep ? " (in the step that faulted, as recorded)"
+                : expected    ? (*expected == hash ? " (matches the recording)" : " (DIFFERS from the recording)")
+                              : "");
     if (!o.exportState.empty()) std::printf("state written to %s\n", o.exportState.c_str());
   }
   if (code == kExitOk && rec->truncated) code = kExitTruncated;

@@ -398,9 +398,11 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
         e.message = c.string("the fault message", kMaxShortString);
         c.finished();
         constexpr int64_t kMaxTick = std::numeric_limits<int64_t>::max();
-        const int64_t covered =
-            std::max({r.header.startTick, ticks.lastCheck, ticks.lastSnapshot,
-                      r.inputs.empty() ? int64_t(0) : std::min(r.inputs.back().tick, kMaxTick - 1) + 1});
+        // An input of tick t is the step from t: a complete recording went past it, a faulted
+        // one may have stopped in that very step (the input that made it fault).
+        const int64_t afterInputs =
+            r.inputs.empty() ? int64_t(0) : std::min(r.inputs.back().tick, kMaxTick - 1) + (e.faulted ? 0 : 1);
+        const int64_t covered = std::max({r.header.startTick, ticks.lastCheck, ticks.lastSnapshot, afterInputs});
         // Bounded above too: a recording hashes at least every checkEvery ticks (and snapshots
         // every snapshotEvery), so a final tick at or beyond the next one due would have had it;
         // and no tick lies more than kMaxTickGap after the last one the file names (a replay of
