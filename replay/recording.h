@@ -27,6 +27,8 @@ struct RecordingSettings {
   std::optional<uint32_t>
       checkEvery;                ///< ticks between state hashes (0: none); unset: 1 up to ~130,000 patches, then fewer
   uint32_t snapshotEvery = 300;  ///< ticks between compressed state snapshots (0: none)
+  // With both intervals 0, step() throws once 65,536 ticks would pass without an input naming a
+  // tick (the reader's tick-span limit, docs/replay-format.md "Limits a reader enforces").
 };
 
 /// Where a session or a recording ended.

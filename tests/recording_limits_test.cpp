@@ -565,6 +565,31 @@ TEST(RecordingLimits, AFullDiskIsOneLineForEveryOutputAndLeavesNoPartialFile) {
   }
 }
 
+TEST(RecordingLimits, SweepOnAFullDiskIsOneLineAndLeavesNoPartialFile) {
+  TempDir dir;
+  const std::string scenario = dir.write("tiny.json", readFile(tinyScenario()));
+  const std::string sweep = cli() + " sweep --scenarios " + quote(scenario) +
+                            " --seconds 0.1 --scalars fx32 --k 1 --dt 1/60 --lod off --repeats 1 --out ";
+  const std::string out = dir.file("out");
+  // ulimit -f 8: the reference recording (in TMPDIR) and the CSV fit, the 30 KB plots do not.
+  const CliResult r =
+      runShell("export TMPDIR=" + quote(dir.path().string()) + "; ulimit -f 8; exec " + sweep + quote(out));
+  EXPECT_EQ(r.exitCode, kExitBadInput) << r.describe();
+  EXPECT_TRUE(isOneLine(r.err)) << r.describe();
+  EXPECT_TRUE(contains(r.err, ".png: cannot write")) << r.describe();
+  for (const fs::directory_entry& f : fs::directory_iterator(out))
+    EXPECT_FALSE(contains(f.path().filename().string(), ".tmp-")) << f.path();
+  for (const fs::directory_entry& f : fs::directory_iterator(dir.path()))  // the reference recording went
+    EXPECT_FALSE(contains(f.path().filename().string(), "simgrass-sweep-")) << f.path();
+  // The scenario itself as an output (sweep.json in --out) is refused before anything runs.
+  const std::string inOut = dir.write("out/sweep.json", readFile(tinyScenario()));
+  const CliResult c = runCli("sweep --scenarios " + quote(inOut) +
+                             " --seconds 0.1 --scalars fx32 --k 1 --dt 1/60 --lod off --repeats 1 --out " + quote(out));
+  EXPECT_EQ(c.exitCode, kExitBadInput) << c.describe();
+  EXPECT_TRUE(contains(c.err, "expected an output file other than the input")) << c.describe();
+  EXPECT_EQ(readFile(inOut), readFile(tinyScenario()));
+}
+
 TEST(RecordingLimits, ARecordingCutByAFullDiskIsOneLineAndReadsUpToTheCut) {
   TempDir dir;
   const std::string out = dir.file("full.sgr");

@@ -174,7 +174,17 @@ void runReference(SweepScenario& sc, int64_t ticks, int64_t interval, int thread
   sc.patches = world->counts().patches();
   const std::string path = temporaryRecordingPath();
   RecordSettings settings;
-  settings.checkEvery = 0, settings.snapshotEvery = 0;  // the sweep never seeks or verifies
+  // The sweep never seeks or verifies: no snapshots, and a hash only as often as the reader
+  // requires some tick to be named (sgr::kMaxTickGap), so that hour-long sweeps record too.
+  settings.checkEvery = uint32_t(sgr::kMaxTickGap), settings.snapshotEvery = 0;
+  // The temporary recording goes whatever happens (a fault, a full disk).
+  struct RemoveAtExit {
+    std::string path;
+    ~RemoveAtExit() {
+      std::error_code ec;
+      fs::remove(path, ec);
+    }
+  } removeAtExit{path};
   {
     Recorder recorder(path, sc.reference, sc.files, *world, settings);
     StepResult last;
@@ -185,11 +195,7 @@ void runReference(SweepScenario& sc, int64_t ticks, int64_t interval, int thread
       }
       if (t == ticks) break;
       last = recorder.step(scriptedInput(sc.reference, t));
-      if (!last.ok) {
-        std::error_code ec;
-        fs::remove(path, ec);
-        throw std::runtime_error(sc.file + ": the reference run faulted: " + last.error.message());
-      }
+      if (!last.ok) throw std::runtime_error(sc.file + ": the reference run faulted: " + last.error.message());
     }
     recorder.finish(last);
   }
@@ -197,12 +203,8 @@ void runReference(SweepScenario& sc, int64_t ticks, int64_t interval, int thread
   try {
     sc.recording = std::make_unique<sgr::Recording>(sgr::readRecording(path));
   } catch (const sgr::RecordingError& e) {
-    std::error_code ec;
-    fs::remove(path, ec);
     throw std::runtime_error(e.what());
   }
-  std::error_code ec;
-  fs::remove(path, ec);
 }
 
 double msSince(std::chrono::steady_clock::time_point t0) {
