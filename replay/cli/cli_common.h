@@ -44,6 +44,9 @@ inline std::string escapeControl(const std::string& text) {
   return out;
 }
 
+/// A user-given value as an error message echoes it: at most 60 bytes, then "...".
+inline std::string echoed(const std::string& value) { return value.size() <= 60 ? value : value.substr(0, 60) + "..."; }
+
 /// Prints one line on stderr: the printf-formatted text (a trailing newline in `format` is
 /// optional) with every control character in it escaped, then one newline. Every error and
 /// warning line of the commands goes through here.

@@ -105,10 +105,10 @@ int compare(const CompareOptions& o) {
       printError("simgrass compare: --variant %s\n", e.what());
       return kExitBadInput;
     } catch (const ScenarioError& e) {
-      printError("simgrass compare: --variant %s: %s\n", text.c_str(), e.what());
+      printError("simgrass compare: --variant %s: %s\n", echoed(text).c_str(), e.what());
       return kExitBadInput;
     } catch (const sgr::RecordingError& e) {
-      printError("simgrass compare: --variant %s: %s\n", text.c_str(), e.what());
+      printError("simgrass compare: --variant %s: %s\n", echoed(text).c_str(), e.what());
       return kExitBadInput;
     }
     row.name = row.settings.describe();

@@ -132,7 +132,7 @@ int diff(const DiffOptions& o) {
   bool heatAtMax = false;
   if (!o.heatmap.empty() && !parseHeatmapTick(o.heatmapTick, a.ticksPerStep, lastCommon, &heatTick, &heatAtMax)) {
     printError("simgrass diff: --heatmap-tick %s: expected 'last', 'max' or a tick from 0 to %" PRId64 "%s\n",
-               o.heatmapTick.c_str(), lastCommon,
+               echoed(o.heatmapTick).c_str(), lastCommon,
                a.ticksPerStep > 1 ? (" that is a multiple of " + std::to_string(a.ticksPerStep)).c_str() : "");
     return kExitBadInput;
   }

@@ -122,11 +122,11 @@ uint64_t maxPayload(ChunkType t) {
     case ChunkType::Input:
       return kMaxInputPayload;
     case ChunkType::Check:
-      return 16;
+      return kMaxCheckPayload;
     case ChunkType::Snapshot:
       return kMaxSnapshotPayload;
     case ChunkType::End:
-      return 8 + 8 + 1 + 4 + 4096;
+      return kMaxEndPayload;
   }
   return 0;
 }
