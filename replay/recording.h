@@ -47,7 +47,7 @@ class RecordingSession {
  public:
   /// Loads a scenario file (empty path: the built-in thesis meadow) and embeds the heightmap it
   /// names, so the recording replays anywhere. Throws ScenarioError for a bad
-  /// scenario, std::runtime_error ("path: why") when `output` cannot be written.
+  /// scenario, std::runtime_error ("path: why") when `output` cannot be written or is the scenario.
   static RecordingSession fromScenarioFile(const std::string& scenarioFile, const std::string& output,
                                            const RecordingSettings& settings = {});
   /// A scenario already parsed (parseScenario). It must name no heightmap file: a recording embeds

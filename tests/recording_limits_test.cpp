@@ -681,6 +681,21 @@ TEST(RecordingLimits, NoCommandOverwritesOneOfItsInputs) {
   for (size_t i = 0; i < inputs.size(); ++i) EXPECT_EQ(readFile(inputs[i]), before[i]) << inputs[i] << " changed";
 }
 
+TEST(RecordingLimits, TheFacadeDoesNotRecordOverItsScenario) {
+  TempDir dir;
+  const std::string scenario = dir.write("x.json", readFile(tinyScenario()));
+  EXPECT_THROW((void)RecordingSession::fromScenarioFile(scenario, scenario), std::runtime_error);
+  EXPECT_EQ(readFile(scenario), readFile(tinyScenario()));
+}
+
+TEST(RecordingLimits, ReplayChecksTheExportFolderBeforeReplaying) {
+  const std::string target = (fs::temp_directory_path() / "h2-no-such-folder" / "state.bin").string();
+  const CliResult r = runCli("replay " + quote(tinyRecording()) + " --export-state " + quote(target));
+  EXPECT_EQ(r.exitCode, kExitBadInput) << r.describe();
+  EXPECT_TRUE(isOneLine(r.err)) << r.describe();
+  EXPECT_EQ(r.out, "") << "it replayed before finding out it could not write";
+}
+
 TEST(RecordingLimits, RecordDoesNotOverwriteTheHeightmapItEmbeds) {
   TempDir dir;
   const std::string png = dir.write("h.png", readFile(test::sourcePath("scenarios/hills.png")));

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "replay/cli/cli_common.h"
+#include "replay/cli/divergence_report.h"
 #include "replay/output_file.h"
 #include "replay/player.h"
 #include "replay/progress.h"
@@ -48,6 +49,7 @@ nlohmann::json headerJson(const sgr::Recording& r) {
 
 int replay(const ReplayOptions& o) {
   if (overwritesInput("replay", "--export-state", o.exportState, {o.file})) return kExitBadInput;
+  if (!canWrite("replay", o.exportState, "state file")) return kExitBadInput;  // before a long replay
   std::unique_ptr<sgr::Recording> rec;
   try {
     rec = std::make_unique<sgr::Recording>(sgr::readRecording(o.file));
