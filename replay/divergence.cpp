@@ -182,11 +182,7 @@ bool writeDivergencePng(const std::string& path, const Observation& a, const Obs
   img.text((width - plot::Canvas::textWidth(middle, textScale)) / 2, textY, middle, textScale, white);
   const std::string right = metres(maxDist);
   img.text(barX1 - plot::Canvas::textWidth(right, textScale), textY, right, textScale, white);
-  if (!stbi_write_png(path.c_str(), width, height, 3, img.img.rgb.data(), width * 3)) {
-    if (error) *error = path + ": expected a writable file for the heat map (cannot write it)";
-    return false;
-  }
-  return true;
+  return plot::writePng(path, img.img, error);
 }
 
 }  // namespace sg

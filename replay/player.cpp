@@ -39,6 +39,25 @@ Scenario recordedScenario(const sgr::Recording& rec, const VariantSettings& over
   return s;
 }
 
+namespace {
+/// An upper bound of the binary state's size (docs/state-format.md) of any world this recording's
+/// field can give, whatever variant replays it (the snapshots hold the recorded scalar, level of
+/// detail and interpolation): 8-byte scalars, a particle per lattice corner, every body it could
+/// spawn (kMaxBodies), every patch mown and a generous warm-start cache (64 entries per pair of
+/// bodies, the terrain counted as a body).
+uint64_t largestState(const WorldCounts& c) {
+  const uint64_t s = 8;
+  const uint64_t bodies = uint64_t(std::max<int64_t>(c.bodies, kMaxBodies));
+  const uint64_t pairs = (bodies + 1) * (bodies + 2) / 2;
+  const uint64_t patches = uint64_t(std::max<int64_t>(c.patches(), 0));
+  const uint64_t corners =
+      uint64_t(std::max<int64_t>(c.patchesX, 0) + 1) * uint64_t(std::max<int64_t>(c.patchesZ, 0) + 1);
+  const uint64_t particles = std::max(corners, uint64_t(std::max<int64_t>(c.particles(), 0)));
+  return 8 + 7 * 12 + 40 + 6 * s * particles + bodies * (13 * s + 8) + 4 + bodies * 32 + 8 + pairs * 64 * (6 * s + 16) +
+         8 + patches * 16 + 16;
+}
+}  // namespace
+
 Player::Player(const sgr::Recording& recording, int threads, const VariantSettings& variant)
     : recording_(recording), threads_(variant.threads.value_or(threads)) {
   scenario_ = recordedScenario(recording, variant);
@@ -55,6 +74,7 @@ Player::Player(const sgr::Recording& recording, int threads, const VariantSettin
     throw sgr::RecordingError(recording.file, sgr::kPreambleBytes,
                               std::string("a scenario this build can run: ") + e.what());
   }
+  largestStateBytes_ = largestState(world_->counts());
   // Spawn commands add bodies up to kMaxBodies: commands may name those indices too.
   const int64_t bodies = std::max<int64_t>(world_->counts().bodies, kMaxBodies);
   for (const sgr::InputRecord& in : recording.inputs)
@@ -84,7 +104,7 @@ StepResult Player::seek(int64_t target, const std::function<void(int64_t)>& prog
   const bool forwardIsShorter = from <= target && (!snap || snap->tick <= from);
   if (!forwardIsShorter) {
     if (snap) {
-      const std::vector<uint8_t> state = recording_.snapshotState(*snap);
+      const std::vector<uint8_t> state = recording_.snapshotState(*snap, largestStateBytes_);
       try {
         world_->restoreState(state);
       } catch (const StateError& e) {
@@ -154,7 +174,7 @@ VerifyReport Player::verify(const std::function<void(int64_t)>& progress) {
     while (nextSnapshot < snapshots.size() && snapshots[nextSnapshot].tick < world_->tick()) ++nextSnapshot;
     if (nextSnapshot < snapshots.size() && snapshots[nextSnapshot].tick == world_->tick()) {
       const sgr::SnapshotInfo& snap = snapshots[nextSnapshot];
-      const std::vector<uint8_t> state = recording_.snapshotState(snap);
+      const std::vector<uint8_t> state = recording_.snapshotState(snap, largestStateBytes_);
       if (exactSettings && state != world_->saveState())
         throw sgr::RecordingError(recording_.file, snap.offset,
                                   "a snapshot holding the state replayed at tick " + std::to_string(snap.tick));

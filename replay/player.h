@@ -38,6 +38,9 @@ class Player {
   int64_t tick() const { return world_->tick(); }
   /// True when the world runs with the recorded settings (hashes are comparable).
   bool sameSettingsAsRecorded() const { return sameSettings_; }
+  /// The largest binary state this scenario can have: a snapshot declaring more is refused
+  /// before it is decompressed.
+  uint64_t largestStateBytes() const { return largestStateBytes_; }
 
   /// Steps once with the recorded input for the current tick.
   StepResult stepForward(StageObserver* observer = nullptr);
@@ -57,6 +60,7 @@ class Player {
   int threads_;
   bool sameSettings_ = true;
   bool exactSettings_ = true;  ///< every setting as recorded (threads aside): snapshots compare byte for byte
+  uint64_t largestStateBytes_ = 0;
   std::unique_ptr<SimWorld> world_;
 };
 

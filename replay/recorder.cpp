@@ -1,6 +1,7 @@
 #include "replay/recorder.h"
 
 #include <xxhash.h>
+#include <stdexcept>
 
 namespace sg {
 
@@ -53,6 +54,7 @@ Recorder::Recorder(const std::string& path, const Scenario& scenario, std::vecto
     : world_(world),
       settings_(settings),
       startTick_(world.tick()),
+      lastNamedTick_(world.tick()),
       writer_(path, makeHeader(scenario, std::move(files), world, settings)) {
   writer_.zstdLevel = settings.zstdLevel;
 }
@@ -60,13 +62,22 @@ Recorder::Recorder(const std::string& path, const Scenario& scenario, std::vecto
 Recorder::~Recorder() = default;
 
 StepResult Recorder::step(const TickInput& input, StageObserver* observer) {
-  writer_.input(world_.tick(), input);
+  const int64_t before = world_.tick();
+  if (writer_.input(before, input)) lastNamedTick_ = before;
+  // On the grid startTick + n * every (the reader insists on it: a missing chunk is damage).
+  const int64_t since = before + 1 - startTick_;
+  const bool check = settings_.checkEvery > 0 && since % settings_.checkEvery == 0;
+  const bool snap = settings_.snapshotEvery > 0 && since % settings_.snapshotEvery == 0;
+  // The reader refuses a tick more than kMaxTickGap after the last one the file names: refuse
+  // the step instead (the file so far stays a readable, cut-off recording).
+  if (!check && !snap && before + 1 - lastNamedTick_ > sgr::kMaxTickGap)
+    throw std::runtime_error(
+        writer_.path() + ": cannot record more than " + std::to_string(sgr::kMaxTickGap) +
+        " ticks without a hash, a snapshot or an input (record with a check or snapshot interval)");
   StepResult r = world_.step(input, observer);
   if (r.ok) {
-    // On the grid startTick + n * every (the reader insists on it: a missing chunk is damage).
-    const int64_t t = world_.tick(), since = t - startTick_;
-    const bool check = settings_.checkEvery > 0 && since % settings_.checkEvery == 0;
-    const bool snap = settings_.snapshotEvery > 0 && since % settings_.snapshotEvery == 0;
+    const int64_t t = world_.tick();
+    if (check || snap) lastNamedTick_ = t;
     if (snap) {
       const std::vector<uint8_t> state = world_.saveState();
       const uint64_t hash = world_.stateHash();

@@ -43,6 +43,7 @@ class Recorder {
   SimWorld& world_;
   RecordSettings settings_;
   int64_t startTick_;
+  int64_t lastNamedTick_;  ///< the last tick a chunk names (the reader bounds the gaps: sgr::kMaxTickGap)
   sgr::Writer writer_;
   bool finished_ = false;
 };

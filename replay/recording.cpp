@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "replay/format/sgr_reader.h"
+#include "replay/input_file.h"
 #include "replay/player.h"
 #include "replay/recorder.h"
 #include "replay/scenario_files.h"
@@ -38,6 +39,9 @@ RecordingSession::~RecordingSession() = default;
 
 RecordingSession RecordingSession::fromScenarioFile(const std::string& scenarioFile, const std::string& output,
                                                     const RecordingSettings& settings) {
+  // The recording must not replace the scenario it is made from.
+  if (!scenarioFile.empty() && sameFile(scenarioFile, output))
+    throw std::runtime_error(output + ": expected a recording file other than the scenario " + scenarioFile);
   std::vector<sgr::EmbeddedFile> files;
   Scenario scenario = loadScenarioFile(scenarioFile, &files);
   return RecordingSession(std::make_unique<Impl>(std::move(scenario), std::move(files), output, settings));

@@ -27,6 +27,8 @@ struct RecordingSettings {
   std::optional<uint32_t>
       checkEvery;                ///< ticks between state hashes (0: none); unset: 1 up to ~130,000 patches, then fewer
   uint32_t snapshotEvery = 300;  ///< ticks between compressed state snapshots (0: none)
+  // With both intervals 0, step() throws once 65,536 ticks would pass without an input naming a
+  // tick (the reader's tick-span limit, docs/replay-format.md "Limits a reader enforces").
 };
 
 /// Where a session or a recording ended.
@@ -45,7 +47,7 @@ class RecordingSession {
  public:
   /// Loads a scenario file (empty path: the built-in thesis meadow) and embeds the heightmap it
   /// names, so the recording replays anywhere. Throws ScenarioError for a bad
-  /// scenario, std::runtime_error ("path: why") when `output` cannot be written.
+  /// scenario, std::runtime_error ("path: why") when `output` cannot be written or is the scenario.
   static RecordingSession fromScenarioFile(const std::string& scenarioFile, const std::string& output,
                                            const RecordingSettings& settings = {});
   /// A scenario already parsed (parseScenario). It must name no heightmap file: a recording embeds

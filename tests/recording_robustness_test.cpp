@@ -144,7 +144,7 @@ TEST(RecordingRobustness, EveryCorpusFileIsListedWithItsExpectedOutcome) {
   }
   for (const char* kind :
        {"cut", "cut-head", "cut-preamble", "flip-type", "flip-length", "flip-payload", "flip-checksum", "magic",
-        "version", "unknown-type", "absurd-length", "zstd", "body-index", "scenario"})
+        "version", "unknown-type", "absurd-length", "zstd", "body-index", "scenario", "missing-chunk", "tick-span"})
     EXPECT_TRUE(kinds.count(kind)) << "no damaged file of kind " << kind;
 }
 

@@ -204,7 +204,7 @@ TEST(RecordingReader, ChecksMustFollowTheirIntervalAndEndMustBeCoveredByThem) {
             std::string::npos);
   // An END far beyond the last check would make a replay run for ever.
   EXPECT_NE(readerError(assemble({head, check(2), end(1000000000000)}))
-                .find("a final tick from 2 to before the next check at 4"),
+                .find("a final tick from 2 to 3 (before the next check or snapshot, due at tick 4)"),
             std::string::npos);
   EXPECT_NE(readerError(
                 assemble({head, std::make_pair(T::Snapshot, sgr::encodeSnapshot(5, 1, std::vector<uint8_t>(9, 1), 1))}))

@@ -2,9 +2,14 @@
 #pragma once
 
 #include <cinttypes>
+#include <cstdarg>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
+#include <initializer_list>
 #include <string>
+
+#include "replay/input_file.h"
 
 namespace sg {
 
@@ -13,6 +18,80 @@ inline std::string hex(uint64_t h) {
   char buf[17];
   std::snprintf(buf, sizeof buf, "%016" PRIx64, h);
   return buf;
+}
+
+/// `text` with every control character escaped (\n, \r, \t, \xNN): what a one-line message
+/// prints of a file name or an error text, so that a newline in either cannot split the line.
+inline std::string escapeControl(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (c < 0x20 || c == 0x7f) {
+      char buf[5];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
+
+/// A user-given value as an error message echoes it: at most 60 bytes, then "...".
+inline std::string echoed(const std::string& value) { return value.size() <= 60 ? value : value.substr(0, 60) + "..."; }
+
+/// Prints one line on stderr: the printf-formatted text (a trailing newline in `format` is
+/// optional) with every control character in it escaped, then one newline. Every error and
+/// warning line of the commands goes through here.
+#if defined(__GNUC__)
+__attribute__((format(printf, 1, 2)))
+#endif
+inline void
+printError(const char* format, ...) {
+  std::va_list args;
+  va_start(args, format);
+  std::va_list again;
+  va_copy(again, args);
+  const int n = std::vsnprintf(nullptr, 0, format, args);
+  va_end(args);
+  std::string text(n > 0 ? size_t(n) : 0, '\0');
+  if (n > 0) std::vsnprintf(text.data(), text.size() + 1, format, again);
+  va_end(again);
+  while (!text.empty() && text.back() == '\n') text.pop_back();
+  const std::string line = escapeControl(text) + "\n";
+  std::fwrite(line.data(), 1, line.size(), stderr);
+  std::fflush(stderr);
+}
+
+/// True, after one line on stderr, when the output file `output` (given with `option`, e.g.
+/// "--export-state") is one of the command's `inputs` (same device and inode: hard links and
+/// "./x" spellings included): the command refuses to overwrite its own input.
+inline bool overwritesInput(const char* command, const char* option, const std::string& output,
+                            std::initializer_list<std::string> inputs) {
+  if (output.empty()) return false;
+  for (const std::string& input : inputs) {
+    if (input.empty() || !sameFile(input, output)) continue;
+    printError("simgrass %s: %s %s: expected an output file other than the input %s (it would be overwritten)", command,
+               option, output.c_str(), input.c_str());
+    return true;
+  }
+  return false;
+}
+
+/// True, after one line on stderr, when two output options name the same file (one would
+/// silently replace the other).
+inline bool sameOutputTwice(const char* command, const char* optionA, const std::string& a, const char* optionB,
+                            const std::string& b) {
+  if (a.empty() || b.empty() || !(a == b || sameFile(a, b))) return false;
+  printError("simgrass %s: %s %s: expected a file other than the %s output", command, optionB, b.c_str(), optionA);
+  return true;
 }
 
 /// Exit codes shared by the commands.

@@ -58,18 +58,20 @@ struct Reference {
 };
 
 int compare(const CompareOptions& o) {
+  if (overwritesInput("compare", "--csv", o.csv, {o.file}) ||
+      overwritesInput("compare", "--series", o.series, {o.file}) ||
+      sameOutputTwice("compare", "--csv", o.csv, "--series", o.series))
+    return kExitBadInput;
   const std::unique_ptr<sgr::Recording> rec = loadRecordingFor("compare", o.file);
   if (!rec) return kExitBadInput;
   const int64_t last = rec->lastTick();
   if (last < 1) {
-    std::fprintf(stderr, "simgrass compare: %s: expected a recording of at least one tick, it holds none\n",
-                 o.file.c_str());
+    printError("simgrass compare: %s: expected a recording of at least one tick, it holds none\n", o.file.c_str());
     return kExitBadInput;
   }
   if (o.ticks > last) {
-    std::fprintf(stderr,
-                 "simgrass compare: --ticks: expected 1 to %" PRId64 " (the recording's last tick), got %" PRId64 "\n",
-                 last, o.ticks);
+    printError("simgrass compare: --ticks: expected 1 to %" PRId64 " (the recording's last tick), got %" PRId64 "\n",
+               last, o.ticks);
     return kExitBadInput;
   }
   const int64_t ticks = o.ticks > 0 ? o.ticks : last;
@@ -81,7 +83,7 @@ int compare(const CompareOptions& o) {
   try {
     recorded = VariantSettings::resolvedFrom(recordedScenario(*rec));
   } catch (const sgr::RecordingError& e) {
-    std::fprintf(stderr, "simgrass compare: %s\n", e.what());
+    printError("simgrass compare: %s\n", e.what());
     return kExitBadInput;
   }
   for (const std::string& text : o.variants) {
@@ -100,13 +102,13 @@ int compare(const CompareOptions& o) {
       row.resolved = VariantSettings::resolvedFrom(s).describe();
       row.mustBeIdentical = row.settings.mustBeIdenticalTo(recorded);
     } catch (const std::invalid_argument& e) {
-      std::fprintf(stderr, "simgrass compare: --variant %s\n", e.what());
+      printError("simgrass compare: --variant %s\n", e.what());
       return kExitBadInput;
     } catch (const ScenarioError& e) {
-      std::fprintf(stderr, "simgrass compare: --variant %s: %s\n", text.c_str(), e.what());
+      printError("simgrass compare: --variant %s: %s\n", echoed(text).c_str(), e.what());
       return kExitBadInput;
     } catch (const sgr::RecordingError& e) {
-      std::fprintf(stderr, "simgrass compare: --variant %s: %s\n", text.c_str(), e.what());
+      printError("simgrass compare: --variant %s: %s\n", echoed(text).c_str(), e.what());
       return kExitBadInput;
     }
     row.name = row.settings.describe();
@@ -128,10 +130,10 @@ int compare(const CompareOptions& o) {
       refRun = std::make_unique<LockStepReplay>(*rec, o.threads);
       varRun = std::make_unique<LockStepReplay>(*rec, o.threads, row.settings);
     } catch (const sgr::RecordingError& e) {
-      std::fprintf(stderr, "simgrass compare: %s\n", e.what());
+      printError("simgrass compare: %s\n", e.what());
       return kExitBadInput;
     } catch (const std::invalid_argument& e) {
-      std::fprintf(stderr, "simgrass compare: --variant %s\n", e.what());
+      printError("simgrass compare: --variant %s\n", e.what());
       return kExitBadInput;
     }
     SimWorld& rw = refRun->world();
@@ -147,8 +149,8 @@ int compare(const CompareOptions& o) {
           ref.msPerTick.push_back(msSince(t0));
           if (!r.ok) {
             bar.finish();
-            std::fprintf(stderr, "simgrass compare: %s: the replay faulted where the recording did not: %s\n",
-                         o.file.c_str(), r.error.message().c_str());
+            printError("simgrass compare: %s: the replay faulted where the recording did not: %s\n", o.file.c_str(),
+                       r.error.message().c_str());
             return kExitMismatch;
           }
           if (t > ref.verifiedTo) {  // each tick once, whichever pass gets there first
@@ -185,13 +187,13 @@ int compare(const CompareOptions& o) {
 
   int code = kExitOk;
   if (ref.firstMismatchTick >= 0) {
-    std::fprintf(stderr, "simgrass compare: %s: hash mismatch at tick %" PRId64 ": recorded %s, replayed %s\n",
-                 o.file.c_str(), ref.firstMismatchTick, hex(ref.expectedHash).c_str(), hex(ref.actualHash).c_str());
+    printError("simgrass compare: %s: hash mismatch at tick %" PRId64 ": recorded %s, replayed %s\n", o.file.c_str(),
+               ref.firstMismatchTick, hex(ref.expectedHash).c_str(), hex(ref.actualHash).c_str());
     code = kExitMismatch;
   }
   for (const Row& row : rows) {
     if (code != kExitOk || !row.failed()) continue;
-    std::fprintf(stderr, "simgrass compare: --variant %s: %s\n", row.name.c_str(), row.status().c_str());
+    printError("simgrass compare: --variant %s: %s\n", row.name.c_str(), row.status().c_str());
     code = kExitMismatch;
   }
   const double refMs = medianOf(ref.msPerTick);
@@ -258,7 +260,7 @@ int compare(const CompareOptions& o) {
     }
     out["variants"] = std::move(list);
     out["ok"] = code == kExitOk;
-    std::printf("%s\n", out.dump(2).c_str());
+    std::printf("%s\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   } else {
     std::printf("recording  %s: %s, ticks 0 to %" PRId64 "\n", o.file.c_str(), rec->header.scenarioSource.c_str(),
                 ticks);

@@ -1,5 +1,6 @@
 #include "replay/cli/diff_command.h"
 
+#include <algorithm>
 #include <cinttypes>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -87,6 +88,10 @@ int diff(const DiffOptions& o) {
   Side a, b;
   a.file = o.a, b.file = o.b;
   if (!canWrite("diff", o.csv, "CSV file") || !canWrite("diff", o.heatmap, "PNG file")) return kExitBadInput;
+  if (overwritesInput("diff", "--csv", o.csv, {o.a, o.b}) ||
+      overwritesInput("diff", "--heatmap", o.heatmap, {o.a, o.b}) ||
+      sameOutputTwice("diff", "--csv", o.csv, "--heatmap", o.heatmap))
+    return kExitBadInput;
   a.rec = loadRecordingFor("diff", o.a);
   if (!a.rec) return kExitBadInput;
   b.rec = loadRecordingFor("diff", o.b);
@@ -105,17 +110,16 @@ int diff(const DiffOptions& o) {
     a.run = std::make_unique<LockStepReplay>(*a.rec, o.threads);
     b.run = std::make_unique<LockStepReplay>(*b.rec, o.threads);
   } catch (const sgr::RecordingError& e) {
-    std::fprintf(stderr, "simgrass diff: %s\n", e.what());
+    printError("simgrass diff: %s\n", e.what());
     return kExitBadInput;
   }
   a.hashes = std::make_unique<RecordedHashes>(*a.rec);
   b.hashes = std::make_unique<RecordedHashes>(*b.rec);
   const WorldCounts ca = a.run->world().counts(), cb = b.run->world().counts();
   if (ca.patchesX != cb.patchesX || ca.patchesZ != cb.patchesZ || ca.bodies != cb.bodies) {
-    std::fprintf(stderr,
-                 "simgrass diff: %s: expected a recording of a field like %s's (%" PRId64 " x %" PRId64
-                 " patches, %" PRId64 " bodies), got %" PRId64 " x %" PRId64 " patches, %" PRId64 " bodies\n",
-                 o.b.c_str(), o.a.c_str(), ca.patchesX, ca.patchesZ, ca.bodies, cb.patchesX, cb.patchesZ, cb.bodies);
+    printError("simgrass diff: %s: expected a recording of a field like %s's (%" PRId64 " x %" PRId64
+               " patches, %" PRId64 " bodies), got %" PRId64 " x %" PRId64 " patches, %" PRId64 " bodies\n",
+               o.b.c_str(), o.a.c_str(), ca.patchesX, ca.patchesZ, ca.bodies, cb.patchesX, cb.patchesZ, cb.bodies);
     return kExitBadInput;
   }
   // Hashes say "same state" only between runs that promise the same states (same settings up to
@@ -127,15 +131,16 @@ int diff(const DiffOptions& o) {
   int64_t heatTick = -1;
   bool heatAtMax = false;
   if (!o.heatmap.empty() && !parseHeatmapTick(o.heatmapTick, a.ticksPerStep, lastCommon, &heatTick, &heatAtMax)) {
-    std::fprintf(stderr, "simgrass diff: --heatmap-tick %s: expected 'last', 'max' or a tick from 0 to %" PRId64 "%s\n",
-                 o.heatmapTick.c_str(), lastCommon,
-                 a.ticksPerStep > 1 ? (" that is a multiple of " + std::to_string(a.ticksPerStep)).c_str() : "");
+    printError("simgrass diff: --heatmap-tick %s: expected 'last', 'max' or a tick from 0 to %" PRId64 "%s\n",
+               echoed(o.heatmapTick).c_str(), lastCommon,
+               a.ticksPerStep > 1 ? (" that is a multiple of " + std::to_string(a.ticksPerStep)).c_str() : "");
     return kExitBadInput;
   }
 
   DivergenceSummary summary;
   std::vector<TickDivergence> series;
-  series.reserve(size_t(steps + 1));
+  // Grown as the replays go, never reserved from the tick count a recording claims.
+  series.reserve(size_t(std::min<int64_t>(steps + 1, 4096)));
   bool heatTaken = false;
   ProgressBar bar("diff", steps, !o.json);
   for (int64_t k = 0; k <= steps; ++k) {
@@ -174,12 +179,12 @@ int diff(const DiffOptions& o) {
   for (const Side* s : {&a, &b}) {
     if (code != kExitOk) break;
     if (s->fault) {
-      std::fprintf(stderr, "simgrass diff: %s: the replay faulted where the recording did not: %s\n", s->file.c_str(),
-                   s->fault->message().c_str());
+      printError("simgrass diff: %s: the replay faulted where the recording did not: %s\n", s->file.c_str(),
+                 s->fault->message().c_str());
       code = kExitMismatch;
     } else if (s->firstMismatchTick >= 0) {
-      std::fprintf(stderr, "simgrass diff: %s: hash mismatch at tick %" PRId64 ": recorded %s, replayed %s\n",
-                   s->file.c_str(), s->firstMismatchTick, hex(s->expectedHash).c_str(), hex(s->actualHash).c_str());
+      printError("simgrass diff: %s: hash mismatch at tick %" PRId64 ": recorded %s, replayed %s\n", s->file.c_str(),
+                 s->firstMismatchTick, hex(s->expectedHash).c_str(), hex(s->actualHash).c_str());
       code = kExitMismatch;
     }
   }
@@ -188,7 +193,7 @@ int diff(const DiffOptions& o) {
     if (!heatTaken) {
       heatError = o.heatmap + ": not written (the replays stopped before tick " + std::to_string(heatTick) + ")";
     } else if (!writeDivergencePng(o.heatmap, a.heat, b.heat, &heatError)) {
-      std::fprintf(stderr, "simgrass diff: %s\n", heatError.c_str());
+      printError("simgrass diff: %s\n", heatError.c_str());
       return kExitBadInput;
     }
   }
@@ -220,7 +225,7 @@ int diff(const DiffOptions& o) {
     nlohmann::json s = nlohmann::json::array();
     for (const TickDivergence& d : series) s.push_back(tickJson(d));
     out["series"] = std::move(s);
-    std::printf("%s\n", out.dump(2).c_str());
+    std::printf("%s\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   } else {
     std::printf("A           %s: %s, %s; %s\n", o.a.c_str(), a.run->player().scenario().name.c_str(),
                 a.settings().c_str(), a.verifiedText().c_str());

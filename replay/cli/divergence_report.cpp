@@ -14,13 +14,12 @@ std::unique_ptr<sgr::Recording> loadRecordingFor(const char* command, const std:
   try {
     rec = std::make_unique<sgr::Recording>(sgr::readRecording(path));
   } catch (const sgr::RecordingError& e) {
-    std::fprintf(stderr, "simgrass %s: %s\n", command, e.what());
+    printError("simgrass %s: %s\n", command, e.what());
     return nullptr;
   }
   if (rec->truncated)
-    std::fprintf(stderr,
-                 "simgrass %s: warning: %s: byte %" PRIu64 ": expected %s; using the %" PRId64 " ticks before it\n",
-                 command, path.c_str(), rec->truncatedAt, rec->truncatedExpected.c_str(), rec->lastTick());
+    printError("simgrass %s: warning: %s: byte %" PRIu64 ": expected %s; using the %" PRId64 " ticks before it\n",
+               command, path.c_str(), rec->truncatedAt, rec->truncatedExpected.c_str(), rec->lastTick());
   return rec;
 }
 
@@ -31,7 +30,7 @@ bool canWrite(const char* command, const std::string& path, const char* what) {
   const fs::path parent = fs::path(path).parent_path();
   const fs::path folder = parent.empty() ? fs::path(".") : parent;
   if (fs::is_directory(folder, ec) && ::access(folder.c_str(), W_OK) == 0 && !fs::is_directory(path, ec)) return true;
-  std::fprintf(stderr, "simgrass %s: %s: expected a %s in an existing, writable folder\n", command, path.c_str(), what);
+  printError("simgrass %s: %s: expected a %s in an existing, writable folder\n", command, path.c_str(), what);
   return false;
 }
 

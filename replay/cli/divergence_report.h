@@ -3,13 +3,16 @@
 #pragma once
 
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "replay/cli/cli_common.h"
 #include "replay/divergence.h"
 #include "replay/format/sgr_reader.h"
+#include "replay/output_file.h"
 
 namespace sg {
 
@@ -41,19 +44,31 @@ void summaryJson(const DivergenceSummary& s, nlohmann::json& out);
 /// One tick as JSON.
 nlohmann::json tickJson(const TickDivergence& d);
 
-/// Writes `header` and then calls rows(FILE*); false with a one-line stderr message on failure.
+/// Writes `header` and then calls rows(FILE*) into memory, then the whole text to `path` with
+/// writeFileAtomic (complete or absent, every write checked); false with a one-line stderr
+/// message on failure.
 template <class Rows>
 bool writeCsv(const char* command, const std::string& path, const std::string& header, Rows&& rows) {
-  std::FILE* f = std::fopen(path.c_str(), "w");
+  char* data = nullptr;
+  size_t size = 0;
+  std::FILE* f = open_memstream(&data, &size);
   if (!f) {
-    std::fprintf(stderr, "simgrass %s: %s: expected a writable CSV file (cannot open it)\n", command, path.c_str());
+    printError("simgrass %s: %s: cannot build the CSV text (out of memory)", command, path.c_str());
     return false;
   }
   std::fprintf(f, "%s\n", header.c_str());
   rows(f);
-  const bool ok = std::ferror(f) == 0;
-  if (std::fclose(f) != 0 || !ok) {
-    std::fprintf(stderr, "simgrass %s: %s: expected a writable CSV file (writing failed)\n", command, path.c_str());
+  const bool built = std::ferror(f) == 0;
+  std::fclose(f);  // sets data and size
+  const std::string text = data ? std::string(data, size) : std::string();
+  std::free(data);
+  std::string error;
+  if (!built) {
+    printError("simgrass %s: %s: cannot build the CSV text", command, path.c_str());
+    return false;
+  }
+  if (!writeFileAtomic(path, text, &error)) {
+    printError("simgrass %s: %s", command, error.c_str());
     return false;
   }
   return true;

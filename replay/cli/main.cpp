@@ -1,7 +1,14 @@
 // simgrass: the SimGrass testbed's command-line tool.
 #include <CLI/CLI.hpp>
+#include <cerrno>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
+#include <exception>
+#include <new>
 #include <string>
+
+#include "replay/cli/cli_common.h"
 
 #include "replay/cli/compare_command.h"
 #include "replay/cli/diff_command.h"
@@ -12,12 +19,23 @@
 #include "replay/cli/sweep_command.h"
 #include "replay/kernel_environment.h"
 
+namespace {
+/// The subcommand being run ("replay"), or "" before one was parsed.
+std::string commandName(const CLI::App& app) {
+  for (const CLI::App* sub : app.get_subcommands()) return sub->get_name();
+  return "";
+}
+}  // namespace
+
 int main(int argc, char** argv) {
+  // A file-size limit (ulimit -f) must be a failed write that the command reports, not SIGXFSZ
+  // killing it half-way through an output.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"SimGrass: deterministic fixed-point grass physics testbed", "simgrass"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("simgrass ") + SIMGRASS_VERSION);
   if (!sg::applyKernelEnvironment()) {
-    std::fprintf(stderr, "simgrass: SIMGRASS_KERNEL: expected scalar, avx2 or auto\n");
+    sg::printError("simgrass: SIMGRASS_KERNEL: expected scalar, avx2 or auto");
     return 2;
   }
   int exitCode = 0;
@@ -38,8 +56,27 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     // One line, non-zero: the command-line counterpart of a bad scenario.
-    std::fprintf(stderr, "simgrass: %s (see 'simgrass --help')\n", e.what());
+    sg::printError("simgrass: %s (see 'simgrass --help')", e.what());
     return 2;
+  } catch (const std::bad_alloc&) {
+    // Last resort: every input is bounded before it is allocated for, so this is a bug (or a
+    // machine out of memory); still one line and a clean exit, never an abort.
+    const std::string cmd = commandName(app);
+    sg::printError("simgrass%s%s: internal error: out of memory", cmd.empty() ? "" : " ", cmd.c_str());
+    return 2;
+  } catch (const std::exception& e) {
+    const std::string cmd = commandName(app);
+    sg::printError("simgrass%s%s: internal error: %s", cmd.empty() ? "" : " ", cmd.c_str(), e.what());
+    return 2;
+  }
+  // What the command printed must have reached its destination: `--json > file` on a full disk
+  // is a failed command, not a truncated file and exit 0.
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    const int err = errno;
+    const std::string cmd = commandName(app);
+    sg::printError("simgrass%s%s: standard output: cannot write (%s)", cmd.empty() ? "" : " ", cmd.c_str(),
+                   std::strerror(err));
+    return exitCode != 0 ? exitCode : 2;
   }
   return exitCode;
 }

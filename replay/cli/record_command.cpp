@@ -1,6 +1,8 @@
 #include "replay/cli/record_command.h"
 
+#include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -25,7 +27,22 @@ struct RecordOptions {
   bool json = false;
 };
 
+/// The most body commands any one tick of `commands` (sorted by tick) holds, and that tick.
+std::pair<size_t, int64_t> busiestTick(const std::vector<ScriptedCommand>& commands) {
+  std::pair<size_t, int64_t> most{0, 0};
+  for (size_t i = 0; i < commands.size();) {
+    size_t j = i;
+    while (j < commands.size() && commands[j].tick == commands[i].tick) ++j;
+    if (j - i > most.first) most = {j - i, commands[i].tick};
+    i = j;
+  }
+  return most;
+}
+
 int record(const RecordOptions& o) {
+  // The recording must not replace the scenario or the input track it is made from (the
+  // heightmap is checked once the scenario names it).
+  if (overwritesInput("record", "-o", o.output, {o.scenario, o.inputTrack})) return kExitBadInput;
   Scenario scenario;
   std::vector<sgr::EmbeddedFile> files;
   std::optional<InputTrack> track;
@@ -43,10 +60,10 @@ int record(const RecordOptions& o) {
     }
     world = makeWorld(scenario, o.threads, physicalMemoryBytes());
   } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "simgrass record: --variant %s\n", e.what());
+    printError("simgrass record: --variant %s\n", e.what());
     return kExitBadInput;
   } catch (const ScenarioError& e) {
-    std::fprintf(stderr, "simgrass record: %s\n", e.what());
+    printError("simgrass record: %s\n", e.what());
     return kExitBadInput;
   }
   const int64_t ticks = o.ticks >= 0 ? o.ticks : (track && track->ticks ? *track->ticks : 600);
@@ -54,11 +71,38 @@ int record(const RecordOptions& o) {
   settings.checkEvery = uint32_t(o.checkEvery >= 0 ? o.checkEvery : defaultCheckEvery(world->counts().patches()));
   settings.snapshotEvery = uint32_t(o.snapshotEvery);
   settings.zstdLevel = o.zstdLevel;
+  // Everything `simgrass replay` would refuse is refused here, before the file is touched.
+  const std::filesystem::path scenarioDir = std::filesystem::path(o.scenario).parent_path();
+  for (const sgr::EmbeddedFile& f : files) {
+    const std::filesystem::path p =
+        std::filesystem::path(f.name).is_absolute() ? std::filesystem::path(f.name) : scenarioDir / f.name;
+    if (overwritesInput("record", "-o", o.output, {p.string()})) return kExitBadInput;
+  }
+  {
+    const uint32_t interval = settings.checkEvery == 0      ? settings.snapshotEvery
+                              : settings.snapshotEvery == 0 ? settings.checkEvery
+                                                            : std::min(settings.checkEvery, settings.snapshotEvery);
+    if ((interval == 0 || interval > sgr::kMaxTickGap) && ticks > sgr::kMaxTickGap) {
+      printError("simgrass record: --ticks: expected at most %" PRId64
+                 " ticks unless --check-every or --snapshot-every is at most %" PRId64
+                 " (a replay refuses a longer stretch without a hash or a snapshot), got %" PRId64,
+                 sgr::kMaxTickGap, sgr::kMaxTickGap, ticks);
+      return kExitBadInput;
+    }
+    const auto [most, atTick] = busiestTick(track ? track->commands : scenario.script);
+    TickInput busiest;
+    busiest.bodies.resize(most);
+    if (const std::string why = sgr::inputProblem(busiest); !why.empty()) {
+      printError("simgrass record: %s: tick %" PRId64 ": expected %s",
+                 track ? o.inputTrack.c_str() : scenario.sourceName.c_str(), atTick, why.c_str());
+      return kExitBadInput;
+    }
+  }
   std::unique_ptr<Recorder> recorder;
   try {
     recorder = std::make_unique<Recorder>(o.output, scenario, files, *world, settings);
   } catch (const std::runtime_error& e) {
-    std::fprintf(stderr, "simgrass record: %s\n", e.what());
+    printError("simgrass record: %s\n", e.what());
     return kExitBadInput;
   }
   StageClock clock;
@@ -73,9 +117,11 @@ int record(const RecordOptions& o) {
     }
     recorder->finish(last);
   } catch (const std::runtime_error& e) {
+    // The recording cannot be written (a full disk, a file-size limit): exit 2, as for every
+    // command's outputs; the file reads up to its last complete chunk.
     progress.finish();
-    std::fprintf(stderr, "simgrass record: %s\n", e.what());
-    return kExitMismatch;
+    printError("simgrass record: %s\n", e.what());
+    return kExitBadInput;
   }
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -93,7 +139,7 @@ int record(const RecordOptions& o) {
     j["snapshotEvery"] = settings.snapshotEvery;
     j["msPerTick"] = ran > 0 ? seconds * 1e3 / double(ran) : 0.0;
     if (!last.ok) j["error"] = last.error.message();
-    std::printf("%s\n", j.dump(2).c_str());
+    std::printf("%s\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   } else {
     std::printf("recorded   %" PRId64 " ticks of %s (%s) to %s\n", ran, scenario.name.c_str(),
                 VariantSettings::resolvedFrom(scenario).describe().c_str(), o.output.c_str());
@@ -104,7 +150,11 @@ int record(const RecordOptions& o) {
     std::printf("time       %.3f ms/tick\n", ran > 0 ? seconds * 1e3 / double(ran) : 0.0);
   }
   if (!last.ok) {
-    std::fprintf(stderr, "simgrass record: %s (recorded up to it)\n", last.error.message().c_str());
+    // Name the input behind a body's fault (its file and JSON path), as `run` does.
+    const std::string cause =
+        describeInputCause(scenario, track ? &*track : nullptr, last.error.tick, last.error.body);
+    printError("simgrass record: %s%s (recorded up to it)\n", last.error.message().c_str(),
+               cause.empty() ? "" : ("; " + cause).c_str());
     return kExitMismatch;
   }
   return kExitOk;

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "replay/cli/cli_common.h"
+#include "replay/cli/divergence_report.h"
 #include "replay/output_file.h"
 #include "replay/player.h"
 #include "replay/progress.h"
@@ -47,22 +48,23 @@ nlohmann::json headerJson(const sgr::Recording& r) {
 }
 
 int replay(const ReplayOptions& o) {
+  if (overwritesInput("replay", "--export-state", o.exportState, {o.file})) return kExitBadInput;
+  if (!canWrite("replay", o.exportState, "state file")) return kExitBadInput;  // before a long replay
   std::unique_ptr<sgr::Recording> rec;
   try {
     rec = std::make_unique<sgr::Recording>(sgr::readRecording(o.file));
   } catch (const sgr::RecordingError& e) {
-    std::fprintf(stderr, "simgrass replay: %s\n", e.what());
+    printError("simgrass replay: %s\n", e.what());
     return kExitBadInput;
   }
   if (rec->truncated)
-    std::fprintf(stderr,
-                 "simgrass replay: warning: %s: byte %" PRIu64 ": expected %s; replaying the %" PRId64
-                 " ticks before it\n",
-                 o.file.c_str(), rec->truncatedAt, rec->truncatedExpected.c_str(), rec->lastTick());
+    printError("simgrass replay: warning: %s: byte %" PRIu64 ": expected %s; replaying the %" PRId64
+               " ticks before it\n",
+               o.file.c_str(), rec->truncatedAt, rec->truncatedExpected.c_str(), rec->lastTick());
   nlohmann::json out = headerJson(*rec);
   if (o.info) {
     if (o.json) {
-      std::printf("%s\n", out.dump(2).c_str());
+      std::printf("%s\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
     } else {
       std::printf("recording  %s (%s)\n", o.file.c_str(), rec->end ? "complete" : "cut off before END");
       std::printf("scenario   %s, %s\n", rec->header.scenarioSource.c_str(), rec->header.variant.c_str());
@@ -78,18 +80,20 @@ int replay(const ReplayOptions& o) {
   try {
     player = std::make_unique<Player>(*rec, o.threads);
   } catch (const sgr::RecordingError& e) {
-    std::fprintf(stderr, "simgrass replay: %s\n", e.what());
+    printError("simgrass replay: %s\n", e.what());
     return kExitBadInput;
   }
   const int64_t last = rec->lastTick();
   if (o.to > last) {
-    std::fprintf(stderr,
-                 "simgrass replay: --to: expected a tick from %" PRId64 " to %" PRId64
-                 " (the recording's last), got %" PRId64 "\n",
-                 rec->header.startTick, last, o.to);
+    printError("simgrass replay: --to: expected a tick from %" PRId64 " to %" PRId64
+               " (the recording's last), got %" PRId64 "\n",
+               rec->header.startTick, last, o.to);
     return kExitBadInput;
   }
   int code = kExitOk;
+  // Verifying a recording that stopped on a fault replays the faulting step too: the world is left
+  // in that step's state, which no recorded hash describes.
+  bool inFaultedStep = false;
   const auto start = std::chrono::steady_clock::now();
   try {
     if (o.verify) {
@@ -103,45 +107,52 @@ int replay(const ReplayOptions& o) {
         out["firstMismatchTick"] = v.firstMismatchTick;
         if (v.fault) {
           out["error"] = v.fault->message();
-          std::fprintf(stderr, "simgrass replay: %s: the replay faulted where the recording did not: %s\n",
-                       o.file.c_str(), v.fault->message().c_str());
+          printError("simgrass replay: %s: the replay faulted where the recording did not: %s\n", o.file.c_str(),
+                     v.fault->message().c_str());
         } else {
           out["expectedHash"] = hex(v.expectedHash);
           out["actualHash"] = hex(v.actualHash);
-          std::fprintf(stderr, "simgrass replay: %s: hash mismatch at tick %" PRId64 ": recorded %s, replayed %s\n",
-                       o.file.c_str(), v.firstMismatchTick, hex(v.expectedHash).c_str(), hex(v.actualHash).c_str());
+          printError("simgrass replay: %s: hash mismatch at tick %" PRId64 ": recorded %s, replayed %s\n",
+                     o.file.c_str(), v.firstMismatchTick, hex(v.expectedHash).c_str(), hex(v.actualHash).c_str());
         }
         code = kExitMismatch;
       } else if (!o.json) {
         std::printf("verified %" PRId64 " ticks (%" PRId64 " hashes match)\n", v.ticks, v.checksVerified);
       }
+      inFaultedStep = v.ok && rec->end && rec->end->faulted;
     }
     if (code == kExitOk && (o.to >= 0 || !o.verify)) {
+      if (inFaultedStep) {  // seek from a fresh world, not from inside the faulted step
+        player = std::make_unique<Player>(*rec, o.threads);
+        inFaultedStep = false;
+      }
       const int64_t target = o.to >= 0 ? o.to : last;
       ProgressBar bar("seek", target, !o.json);
       const StepResult r = player->seek(target, [&bar](int64_t done) { bar.update(done); });
       bar.finish();
       if (!r.ok) {
-        std::fprintf(stderr, "simgrass replay: %s\n", r.error.message().c_str());
+        printError("simgrass replay: %s\n", r.error.message().c_str());
         out["error"] = r.error.message();
         code = kExitMismatch;
       }
     }
   } catch (const sgr::RecordingError& e) {
-    std::fprintf(stderr, "simgrass replay: %s\n", e.what());
+    printError("simgrass replay: %s\n", e.what());
     return kExitBadInput;
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const int64_t tick = player->tick();
   const uint64_t hash = player->world().stateHash();
-  const std::optional<uint64_t> expected = recordedHash(*rec, tick);
+  std::optional<uint64_t> expected;
+  if (!inFaultedStep) expected = recordedHash(*rec, tick);
+  if (inFaultedStep) out["recordedFault"] = rec->end->message;
   out["tick"] = tick;
   out["hash"] = hex(hash);
   out["seconds"] = seconds;
   if (expected) out["matchesRecording"] = *expected == hash;
   if (code == kExitOk && expected && *expected != hash) {
-    std::fprintf(stderr, "simgrass replay: %s: hash at tick %" PRId64 " is %s, the recording has %s\n", o.file.c_str(),
-                 tick, hex(hash).c_str(), hex(*expected).c_str());
+    printError("simgrass replay: %s: hash at tick %" PRId64 " is %s, the recording has %s\n", o.file.c_str(), tick,
+               hex(hash).c_str(), hex(*expected).c_str());
     code = kExitMismatch;
   }
   if (!o.exportState.empty()) {
@@ -157,16 +168,18 @@ int replay(const ReplayOptions& o) {
       written = writeFileAtomic(o.exportState, player->world().saveState(), &error);
     }
     if (!written) {
-      std::fprintf(stderr, "simgrass replay: %s\n", error.c_str());
+      printError("simgrass replay: %s\n", error.c_str());
       return kExitBadInput;
     }
     out["exportedState"] = o.exportState;
   }
   if (o.json) {
-    std::printf("%s\n", out.dump(2).c_str());
+    std::printf("%s\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   } else {
     std::printf("tick %" PRId64 " hash %s%s\n", tick, hex(hash).c_str(),
-                expected ? (*expected == hash ? " (matches the recording)" : " (DIFFERS from the recording)") : "");
+                inFaultedStep ? " (in the step that faulted, as recorded)"
+                : expected    ? (*expected == hash ? " (matches the recording)" : " (DIFFERS from the recording)")
+                              : "");
     if (!o.exportState.empty()) std::printf("state written to %s\n", o.exportState.c_str());
   }
   if (code == kExitOk && rec->truncated) code = kExitTruncated;

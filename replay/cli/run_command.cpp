@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "replay/cli/cli_common.h"
 #include "replay/progress.h"
 #include "replay/scenario_files.h"
 #include "replay/stage_clock.h"
@@ -52,11 +53,11 @@ int runScenario(const RunOptions& o) {
     if (o.kernel == "scalar" || o.kernel == "avx2")
       world->setParticleKernel(o.kernel == "avx2" ? ParticleKernel::Avx2 : ParticleKernel::Scalar);
   } catch (const ScenarioError& e) {
-    std::fprintf(stderr, "simgrass run: %s\n", e.what());
+    printError("simgrass run: %s\n", e.what());
     return 2;
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "simgrass run: %s: $.field: expected a field that fits in memory (allocation failed)\n",
-                 o.scenario.empty() ? "<built-in>" : o.scenario.c_str());
+    printError("simgrass run: %s: $.field: expected a field that fits in memory (allocation failed)\n",
+               o.scenario.empty() ? "<built-in>" : o.scenario.c_str());
     return 2;
   }
   const WorldCounts counts = world->counts();
@@ -117,7 +118,7 @@ int runScenario(const RunOptions& o) {
                    {"patchStepsPerSecond", patchSteps},
                    {"stageMsPerTick", stages}};
     if (!failure.ok) j["error"] = failure.error.message();
-    std::printf("%s\n", j.dump(2).c_str());
+    std::printf("%s\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   } else {
     std::printf("scenario   %s (%s)\n", scenario.name.c_str(), scenario.sourceName.c_str());
     std::printf("scalar     %s, interpolation k=%d, %d thread%s, %s particle kernel\n", scalarName(scenario.scalar),
@@ -147,8 +148,7 @@ int runScenario(const RunOptions& o) {
   if (!failure.ok) {
     // Name the input behind a body's fault (its file and JSON path), not only the tick.
     const std::string cause = describeInputCause(scenario, nullptr, failure.error.tick, failure.error.body);
-    std::fprintf(stderr, "simgrass run: %s%s\n", failure.error.message().c_str(),
-                 cause.empty() ? "" : ("; " + cause).c_str());
+    printError("simgrass run: %s%s\n", failure.error.message().c_str(), cause.empty() ? "" : ("; " + cause).c_str());
     return 1;
   }
   return 0;

@@ -19,6 +19,7 @@
 #include "replay/cli/divergence_report.h"
 #include "replay/divergence.h"
 #include "replay/lockstep.h"
+#include "replay/output_file.h"
 #include "replay/progress.h"
 #include "replay/recorder.h"
 #include "replay/report/pareto.h"
@@ -173,7 +174,17 @@ void runReference(SweepScenario& sc, int64_t ticks, int64_t interval, int thread
   sc.patches = world->counts().patches();
   const std::string path = temporaryRecordingPath();
   RecordSettings settings;
-  settings.checkEvery = 0, settings.snapshotEvery = 0;  // the sweep never seeks or verifies
+  // The sweep never seeks or verifies: no snapshots, and a hash only as often as the reader
+  // requires some tick to be named (sgr::kMaxTickGap), so that hour-long sweeps record too.
+  settings.checkEvery = uint32_t(sgr::kMaxTickGap), settings.snapshotEvery = 0;
+  // The temporary recording goes whatever happens (a fault, a full disk).
+  struct RemoveAtExit {
+    std::string path;
+    ~RemoveAtExit() {
+      std::error_code ec;
+      fs::remove(path, ec);
+    }
+  } removeAtExit{path};
   {
     Recorder recorder(path, sc.reference, sc.files, *world, settings);
     StepResult last;
@@ -184,11 +195,7 @@ void runReference(SweepScenario& sc, int64_t ticks, int64_t interval, int thread
       }
       if (t == ticks) break;
       last = recorder.step(scriptedInput(sc.reference, t));
-      if (!last.ok) {
-        std::error_code ec;
-        fs::remove(path, ec);
-        throw std::runtime_error(sc.file + ": the reference run faulted: " + last.error.message());
-      }
+      if (!last.ok) throw std::runtime_error(sc.file + ": the reference run faulted: " + last.error.message());
     }
     recorder.finish(last);
   }
@@ -196,12 +203,8 @@ void runReference(SweepScenario& sc, int64_t ticks, int64_t interval, int thread
   try {
     sc.recording = std::make_unique<sgr::Recording>(sgr::readRecording(path));
   } catch (const sgr::RecordingError& e) {
-    std::error_code ec;
-    fs::remove(path, ec);
     throw std::runtime_error(e.what());
   }
-  std::error_code ec;
-  fs::remove(path, ec);
 }
 
 double msSince(std::chrono::steady_clock::time_point t0) {
@@ -357,8 +360,7 @@ bool prepareOutputFolder(const std::string& dir) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (fs::is_directory(dir, ec) && ::access(dir.c_str(), W_OK) == 0) return true;
-  std::fprintf(stderr, "simgrass sweep: --out %s: expected a writable folder (or one that can be created)\n",
-               dir.c_str());
+  printError("simgrass sweep: --out %s: expected a writable folder (or one that can be created)\n", dir.c_str());
   return false;
 }
 
@@ -395,13 +397,13 @@ int sweep(const SweepOptions& o) {
     axes = parseAxes(o);
     interval = commonInterval(axes.dts, refDt);
   } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "simgrass sweep: %s\n", e.what());
+    printError("simgrass sweep: %s\n", e.what());
     return kExitBadInput;
   }
   const int64_t ticks = int64_t(std::floor(o.seconds / refDt.toDouble() + 1e-9)) / interval * interval;
   if (ticks < interval) {
-    std::fprintf(stderr, "simgrass sweep: --seconds: expected at least %g s (one step of the coarsest dt), got %g\n",
-                 double(interval) * refDt.toDouble(), o.seconds);
+    printError("simgrass sweep: --seconds: expected at least %g s (one step of the coarsest dt), got %g\n",
+               double(interval) * refDt.toDouble(), o.seconds);
     return kExitBadInput;
   }
 
@@ -425,12 +427,20 @@ int sweep(const SweepOptions& o) {
       for (ScalarKind scalar : axes.scalars) validateForScalar(s, scalar, physicalMemoryBytes());
       sc.reference = std::move(s);
     } catch (const ScenarioError& e) {
-      std::fprintf(stderr, "simgrass sweep: %s\n", e.what());
+      printError("simgrass sweep: %s\n", e.what());
       return kExitBadInput;
     }
     scenarios.push_back(std::move(sc));
   }
   if (!prepareOutputFolder(o.out)) return kExitBadInput;
+  // No output may replace one of the scenarios it is computed from.
+  auto overwritesScenario = [&](const std::string& output) {
+    for (const SweepScenario& sc : scenarios)
+      if (overwritesInput("sweep", "--out", output, {sc.file})) return true;
+    return false;
+  };
+  for (const char* name : {"sweep.csv", "sweep.json"})
+    if (overwritesScenario((fs::path(o.out) / name).string())) return kExitBadInput;
 
   std::vector<SweepRow> rows;
   for (size_t s = 0; s < scenarios.size(); ++s)
@@ -456,7 +466,7 @@ int sweep(const SweepOptions& o) {
       runReference(sc, ticks, interval, o.threads);
     } catch (const std::exception& e) {
       bar.finish();
-      std::fprintf(stderr, "simgrass sweep: %s\n", e.what());
+      printError("simgrass sweep: %s\n", e.what());
       return kExitMismatch;
     }
     done += ticks;
@@ -562,12 +572,13 @@ int sweep(const SweepOptions& o) {
     };
     for (const Kind& k : kinds) {
       const std::string path = (fs::path(o.out) / (base + "-" + k.suffix + ".png")).string();
+      if (overwritesScenario(path)) return kExitBadInput;
       std::string error;
       if (!plot::writePng(
               path,
               plot::render(errorPlot(scenarios[s], mine, axes, k.what, k.unit, k.error, k.front, o.repeats, o.threads)),
               &error)) {
-        std::fprintf(stderr, "simgrass sweep: %s\n", error.c_str());
+        printError("simgrass sweep: %s\n", error.c_str());
         return kExitBadInput;
       }
       pngs.push_back(path);
@@ -576,10 +587,9 @@ int sweep(const SweepOptions& o) {
   doc["plots"] = pngs;
   const std::string jsonPath = (fs::path(o.out) / "sweep.json").string();
   {
-    std::FILE* f = std::fopen(jsonPath.c_str(), "w");
-    const std::string text = doc.dump(2) + "\n";
-    if (!f || std::fwrite(text.data(), 1, text.size(), f) != text.size() || std::fclose(f) != 0) {
-      std::fprintf(stderr, "simgrass sweep: %s: expected a writable JSON file (writing failed)\n", jsonPath.c_str());
+    std::string error;
+    if (!writeFileAtomic(jsonPath, doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", &error)) {
+      printError("simgrass sweep: %s", error.c_str());
       return kExitBadInput;
     }
   }
@@ -587,7 +597,7 @@ int sweep(const SweepOptions& o) {
   int faults = 0;
   for (const SweepRow& r : rows) faults += r.fault.empty() ? 0 : 1;
   if (o.json) {
-    std::printf("%s\n", doc.dump(2).c_str());
+    std::printf("%s\n", doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   } else {
     std::printf(
         "reference  scalar=double interp=1 dt=%s lod=off; %g simulated s, compared every %g s; cost: median "
@@ -621,8 +631,8 @@ int sweep(const SweepOptions& o) {
         "accurate (tip RMS error).\n");
   }
   if (faults > 0) {
-    std::fprintf(stderr, "simgrass sweep: %d variant%s faulted (status column in %s)\n", faults, faults == 1 ? "" : "s",
-                 csvPath.c_str());
+    printError("simgrass sweep: %d variant%s faulted (status column in %s)\n", faults, faults == 1 ? "" : "s",
+               csvPath.c_str());
     return kExitMismatch;
   }
   return kExitOk;

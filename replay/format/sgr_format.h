@@ -37,12 +37,32 @@ enum class ChunkType : uint32_t {
 };
 const char* chunkTypeName(ChunkType type);
 
-/// Largest payload the reader accepts per chunk type (a bit flip in a length cannot make it
-/// allocate more; a SNAP holds at most the compressed state of a 4096 x 4096 meadow in double).
+/// Limits shared by the writer and the reader (docs/replay-format.md, "Limits a reader
+/// enforces"): the writer refuses, before writing, anything the reader would refuse, so a
+/// recording that `simgrass record` finishes always replays.
+///
+/// Largest payload per chunk type (a bit flip in a length cannot make the reader allocate more;
+/// a SNAP holds at most the compressed state of a 4096 x 4096 meadow in double).
 inline constexpr uint64_t kMaxHeadPayload = uint64_t(256) << 20;
 inline constexpr uint64_t kMaxInputPayload = uint64_t(1) << 20;
+inline constexpr uint64_t kMaxCheckPayload = 16;
 inline constexpr uint64_t kMaxSnapshotPayload = uint64_t(1) << 31;
 inline constexpr uint64_t kMaxSnapshotRawBytes = uint64_t(1) << 32;
+/// Short strings: the variant, the scenario file name, embedded file names, the build id and
+/// END's fault message (which the writer shortens to fit).
+inline constexpr uint64_t kMaxShortString = 4096;
+inline constexpr uint64_t kMaxEndPayload = 8 + 8 + 1 + 4 + kMaxShortString;
+inline constexpr uint32_t kMaxEmbeddedFiles = 16;
+/// Most ticks between two ticks the file itself names (tick 0, the start tick, every INPT, CHCK
+/// and SNAP tick, the END tick): a forged tick cannot make a replay run for ever, since the ticks
+/// a file can claim grow with its size, at most 65536 ticks per chunk (4.5 minutes at 240 Hz; a
+/// recording with a hash or a snapshot at least that often, as by default, is never near it).
+inline constexpr int64_t kMaxTickGap = int64_t(1) << 16;
+
+/// Bytes of an INPT payload for `input` (the writer checks it against kMaxInputPayload).
+inline constexpr uint64_t inputPayloadBytes(size_t commands, bool cameraChanged) {
+  return 8 + 1 + (cameraChanged ? 1 + 24 : 0) + 4 + uint64_t(commands) * (4 + 1 + 24);
+}
 
 /// A file the scenario named (the heightmap), embedded so that the recording is self-contained.
 struct EmbeddedFile {

@@ -4,10 +4,13 @@
 #include <xxhash.h>
 #include <zstd.h>
 #include <algorithm>
+#include <array>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <limits>
+#include <memory>
+#include <new>
+
+#include "replay/input_file.h"
 
 namespace sg::sgr {
 
@@ -119,11 +122,11 @@ uint64_t maxPayload(ChunkType t) {
     case ChunkType::Input:
       return kMaxInputPayload;
     case ChunkType::Check:
-      return 16;
+      return kMaxCheckPayload;
     case ChunkType::Snapshot:
       return kMaxSnapshotPayload;
     case ChunkType::End:
-      return 8 + 8 + 1 + 4 + 4096;
+      return kMaxEndPayload;
   }
   return 0;
 }
@@ -143,6 +146,49 @@ std::string typeText(uint32_t t) {
   return "'" + s + "'";
 }
 
+/// Tick bookkeeping shared by the chunk parsers: the last tick the file named and the grid
+/// positions of CHCK and SNAP chunks seen so far.
+struct Ticks {
+  int64_t lastNamed = 0;  ///< tick 0 is where every replay starts
+  int64_t lastCheck = -1, lastSnapshot = -1;
+};
+
+/// A tick the file names must lie at most kMaxTickGap ticks after the last one it named: the
+/// ticks a recording can claim grow with its size, so a forged tick cannot make a replay (or the
+/// `diff` series, or a viewer seek) run for ever.
+void expectReachable(const Cursor& c, uint64_t at, int64_t tick, Ticks& ticks, const char* what) {
+  if (tick > ticks.lastNamed && tick - ticks.lastNamed > kMaxTickGap)
+    c.fail(at, std::string(what) + " at most " + std::to_string(kMaxTickGap) + " ticks after tick " +
+                   std::to_string(ticks.lastNamed) + " (the last tick the file names before it), got tick " +
+                   std::to_string(tick));
+  ticks.lastNamed = std::max(ticks.lastNamed, tick);
+}
+
+/// The next CHCK (SNAP) tick the header promises, or INT64_MAX when it promises none.
+int64_t nextCheckTick(const Recording& r, const Ticks& t) {
+  return nextOnGrid(t.lastCheck, r.header.startTick, r.header.checkEvery);
+}
+int64_t nextSnapshotTick(const Recording& r, const Ticks& t) {
+  return nextOnGrid(t.lastSnapshot, r.header.startTick, r.header.snapshotEvery);
+}
+
+/// The recorder writes, for each tick t, SNAP t and CHCK t (when due) before INPT t and before
+/// anything of a later tick: a chunk of tick `tick` means every CHCK and SNAP the header promises
+/// up to `tick` (before it, with `strictlyBefore`) is present. A recording stripped of its
+/// snapshots or checks is damaged, not merely shorter.
+void expectPromisedBefore(const Recording& r, const Cursor& c, uint64_t at, int64_t tick, const Ticks& t,
+                          bool checksToo, bool snapshotsToo, bool strictlyBefore, const char* what) {
+  auto missing = [&](int64_t due) { return strictlyBefore ? due < tick : due <= tick; };
+  const int64_t check = nextCheckTick(r, t), snapshot = nextSnapshotTick(r, t);
+  if (checksToo && missing(check))
+    c.fail(at, "the CHCK chunk of tick " + std::to_string(check) + " before " + what + " of tick " +
+                   std::to_string(tick) + " (HEAD says checkEvery = " + std::to_string(r.header.checkEvery) + ")");
+  if (snapshotsToo && missing(snapshot))
+    c.fail(at, "the SNAP chunk of tick " + std::to_string(snapshot) + " before " + what + " of tick " +
+                   std::to_string(tick) + " (HEAD says snapshotEvery = " + std::to_string(r.header.snapshotEvery) +
+                   ")");
+}
+
 void parseHead(Recording& r, Cursor& c) {
   Header& h = r.header;
   const uint64_t scalarAt = c.offset();
@@ -157,27 +203,30 @@ void parseHead(Recording& r, Cursor& c) {
   h.initialStateHash = c.get<uint64_t>("the initial state hash");
   const uint64_t startAt = c.offset();
   h.startTick = c.get<int64_t>("the start tick");
-  if (h.startTick < 0) c.fail(startAt, "a non-negative start tick");
-  h.variant = c.string("the variant settings", 4096);
-  h.scenarioSource = c.string("the scenario file name", 4096);
+  // Every replay starts from tick 0 (a fresh world): the start tick must be reachable from there.
+  if (h.startTick < 0 || h.startTick > kMaxTickGap)
+    c.fail(startAt, "a start tick from 0 to " + std::to_string(kMaxTickGap) + ", got " + std::to_string(h.startTick));
+  h.variant = c.string("the variant settings", kMaxShortString);
+  h.scenarioSource = c.string("the scenario file name", kMaxShortString);
   const uint64_t textAt = c.offset();
-  h.scenarioText = c.string("the scenario text", kMaxHeadPayload);
+  h.scenarioText = c.string("the scenario text", InputLimits::kScenarioBytes);  // as a scenario file
   if (XXH3_64bits(h.scenarioText.data(), h.scenarioText.size()) != h.scenarioHash)
     c.fail(textAt, "scenario text matching its hash");
   const uint64_t countAt = c.offset();
   const uint32_t files = c.get<uint32_t>("the embedded file count");
-  if (files > 16) c.fail(countAt, "at most 16 embedded files, got " + std::to_string(files));
+  if (files > kMaxEmbeddedFiles)
+    c.fail(countAt, "at most " + std::to_string(kMaxEmbeddedFiles) + " embedded files, got " + std::to_string(files));
   for (uint32_t f = 0; f < files; ++f) {
     EmbeddedFile e;
-    e.name = c.string("an embedded file name", 4096);
+    e.name = c.string("an embedded file name", kMaxShortString);
     e.bytes = c.bytes("an embedded file");
     h.files.push_back(std::move(e));
   }
-  h.buildId = c.string("the build id", 4096);
+  h.buildId = c.string("the build id", kMaxShortString);
   c.finished();
 }
 
-void parseInput(Recording& r, Cursor& c, TickInput& camera) {
+void parseInput(Recording& r, Cursor& c, TickInput& camera, Ticks& ticks) {
   const uint64_t tickAt = c.offset();
   InputRecord rec;
   rec.offset = tickAt;
@@ -185,6 +234,8 @@ void parseInput(Recording& r, Cursor& c, TickInput& camera) {
   const int64_t after = r.inputs.empty() ? r.header.startTick - 1 : r.inputs.back().tick;
   if (rec.tick <= after)
     c.fail(tickAt, "an input tick after " + std::to_string(after) + ", got " + std::to_string(rec.tick));
+  expectReachable(c, tickAt, rec.tick, ticks, "an input tick");
+  expectPromisedBefore(r, c, tickAt, rec.tick, ticks, true, true, false, "the input");
   const uint64_t flagsAt = c.offset();
   const uint8_t flags = c.get<uint8_t>("the input flags");
   if (flags > 1) c.fail(flagsAt, "input flags 0 or 1, got " + std::to_string(flags));
@@ -221,24 +272,44 @@ void parseInput(Recording& r, Cursor& c, TickInput& camera) {
 }
 }  // namespace
 
-Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
-  Recording r;
-  r.file = file;
-  r.bytes = std::move(bytes);
-  const std::span<const uint8_t> all(r.bytes);
+namespace {
+/// The magic and the version: the same errors whether the whole file or only its first bytes
+/// are at hand (readRecording checks them before reading the rest).
+void checkPreamble(std::span<const uint8_t> all, uint64_t fileSize, const std::string& file) {
   if (all.size() < kPreambleBytes || std::memcmp(all.data(), kMagic, sizeof kMagic) != 0) {
     if (all.size() >= sizeof kMagic && std::memcmp(all.data(), kMagic, sizeof kMagic) != 0)
       throw RecordingError(file, 0, "the .sgr magic \\x89SGR\\r\\n\\x1a\\n (not a SimGrass recording)");
-    throw RecordingError(file, all.size(), "the 12-byte .sgr preamble (the file ends early)");
+    throw RecordingError(file, fileSize, "the 12-byte .sgr preamble (the file ends early)");
   }
   const uint32_t version = loadLE<uint32_t>(all.data() + 8);
   if (version != kFormatVersion)
     throw RecordingError(file, 8,
                          "format version " + std::to_string(kFormatVersion) + ", got " + std::to_string(version));
+}
+
+/// A chunk header's type and length, checked before anything is read or allocated by them.
+ChunkType checkChunkHeader(uint32_t type, uint32_t length, uint64_t at, const std::string& file) {
+  if (!knownType(type))
+    throw RecordingError(file, at, "a chunk type HEAD, INPT, CHCK, SNAP or END, got " + typeText(type));
+  const ChunkType t = ChunkType(type);
+  if (length > maxPayload(t))
+    throw RecordingError(file, at + 4,
+                         std::string("a ") + chunkTypeName(t) + " payload of at most " + std::to_string(maxPayload(t)) +
+                             " bytes, got " + std::to_string(length));
+  return t;
+}
+}  // namespace
+
+Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
+  Recording r;
+  r.file = file;
+  r.bytes = std::move(bytes);
+  const std::span<const uint8_t> all(r.bytes);
+  checkPreamble(all, all.size(), file);
 
   uint64_t at = kPreambleBytes;
   bool haveHead = false;
-  int64_t lastCheck = -1, lastSnapshot = -1;
+  Ticks ticks;
   TickInput camera;
   auto truncate = [&](uint64_t where, const std::string& expected) {
     r.truncated = true;
@@ -251,15 +322,8 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
       truncate(at, "an 8-byte chunk header");
       break;
     }
-    const uint32_t type = loadLE<uint32_t>(all.data() + at);
     const uint32_t length = loadLE<uint32_t>(all.data() + at + 4);
-    if (!knownType(type))
-      throw RecordingError(file, at, "a chunk type HEAD, INPT, CHCK, SNAP or END, got " + typeText(type));
-    const ChunkType t = ChunkType(type);
-    if (length > maxPayload(t))
-      throw RecordingError(file, at + 4,
-                           std::string("a ") + chunkTypeName(t) + " payload of at most " +
-                               std::to_string(maxPayload(t)) + " bytes, got " + std::to_string(length));
+    const ChunkType t = checkChunkHeader(loadLE<uint32_t>(all.data() + at), length, at, file);
     const uint64_t total = kChunkHeaderBytes + uint64_t(length) + kChunkTrailerBytes;
     if (all.size() - at < total) {
       truncate(at, std::string("a ") + chunkTypeName(t) + " chunk of " + std::to_string(total) + " bytes, " +
@@ -277,19 +341,22 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
     switch (t) {
       case ChunkType::Head:
         parseHead(r, c);
+        ticks.lastNamed = r.header.startTick;
         haveHead = true;
         break;
       case ChunkType::Input:
-        parseInput(r, c, camera);
+        parseInput(r, c, camera, ticks);
         break;
       case ChunkType::Check: {
         Check k;
         k.tick = c.get<int64_t>("the check tick");
         k.hash = c.get<uint64_t>("the check hash");
         // CHCK chunks come exactly every checkEvery ticks: a missing or stray one is damage.
-        expectOnGrid(c, at + kChunkHeaderBytes, k.tick, lastCheck, r.header.startTick, r.header.checkEvery, "CHCK",
-                     "checkEvery", "check");
-        lastCheck = k.tick;
+        expectOnGrid(c, at + kChunkHeaderBytes, k.tick, ticks.lastCheck, r.header.startTick, r.header.checkEvery,
+                     "CHCK", "checkEvery", "check");
+        expectPromisedBefore(r, c, at + kChunkHeaderBytes, k.tick, ticks, false, true, false, "the check");
+        expectReachable(c, at + kChunkHeaderBytes, k.tick, ticks, "a check");
+        ticks.lastCheck = k.tick;
         r.checks.push_back(k);
         c.finished();
         break;
@@ -300,8 +367,10 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
         s.hash = c.get<uint64_t>("the snapshot hash");
         const uint64_t rawAt = c.offset();
         s.rawBytes = c.get<uint64_t>("the snapshot size");
-        expectOnGrid(c, at + kChunkHeaderBytes, s.tick, lastSnapshot, r.header.startTick, r.header.snapshotEvery,
+        expectOnGrid(c, at + kChunkHeaderBytes, s.tick, ticks.lastSnapshot, r.header.startTick, r.header.snapshotEvery,
                      "SNAP", "snapshotEvery", "snapshot");
+        expectPromisedBefore(r, c, at + kChunkHeaderBytes, s.tick, ticks, true, false, true, "the snapshot");
+        expectReachable(c, at + kChunkHeaderBytes, s.tick, ticks, "a snapshot");
         if (s.rawBytes == 0 || s.rawBytes > kMaxSnapshotRawBytes)
           c.fail(rawAt, "a snapshot size between 1 and " + std::to_string(kMaxSnapshotRawBytes) + " bytes, got " +
                             std::to_string(s.rawBytes));
@@ -314,7 +383,7 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
           c.fail(rawAt, "a snapshot size that " + std::to_string(s.compressedBytes) +
                             " compressed bytes can hold (at most " + std::to_string(canHold) + "), got " +
                             std::to_string(s.rawBytes));
-        lastSnapshot = s.tick;
+        ticks.lastSnapshot = s.tick;
         r.snapshots.push_back(s);
         break;
       }
@@ -326,22 +395,30 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
         const uint8_t faulted = c.get<uint8_t>("the fault flag");
         if (faulted > 1) c.fail(faultAt, "a fault flag 0 or 1, got " + std::to_string(faulted));
         e.faulted = faulted == 1;
-        e.message = c.string("the fault message", 4096);
+        e.message = c.string("the fault message", kMaxShortString);
         c.finished();
         constexpr int64_t kMaxTick = std::numeric_limits<int64_t>::max();
-        const int64_t covered =
-            std::max({r.header.startTick, lastCheck, lastSnapshot,
-                      r.inputs.empty() ? int64_t(0) : std::min(r.inputs.back().tick, kMaxTick - 1) + 1});
-        // Bounded above too: a recording hashes at least every checkEvery ticks, so a final tick
-        // beyond the next check would have had one (and would make a replay run for ever).
-        const int64_t nextCheck = r.header.checkEvery ? nextOnGrid(lastCheck, r.header.startTick, r.header.checkEvery)
-                                                      : std::numeric_limits<int64_t>::max();
+        // An input of tick t is the step from t: a complete recording went past it, a faulted
+        // one may have stopped in that very step (the input that made it fault).
+        const int64_t afterInputs =
+            r.inputs.empty() ? int64_t(0) : std::min(r.inputs.back().tick, kMaxTick - 1) + (e.faulted ? 0 : 1);
+        const int64_t covered = std::max({r.header.startTick, ticks.lastCheck, ticks.lastSnapshot, afterInputs});
+        // Bounded above too: a recording hashes at least every checkEvery ticks (and snapshots
+        // every snapshotEvery), so a final tick at or beyond the next one due would have had it;
+        // and no tick lies more than kMaxTickGap after the last one the file names (a replay of
+        // a forged final tick would run for ever).
+        const int64_t nextDue = std::min(nextCheckTick(r, ticks), nextSnapshotTick(r, ticks));
         // (A faulted END is replayed one step further: its tick must leave room for that step.)
-        const int64_t lastAllowed = std::min(e.faulted ? nextCheck : nextCheck - 1, kMaxTick - 1);
+        const int64_t reachable =
+            ticks.lastNamed > kMaxTick - 1 - kMaxTickGap ? kMaxTick - 1 : ticks.lastNamed + kMaxTickGap;
+        const int64_t lastAllowed = std::min({e.faulted ? nextDue : nextDue - 1, kMaxTick - 1, reachable});
         if (e.tick < covered || e.tick > lastAllowed)
-          c.fail(at + kChunkHeaderBytes, "a final tick from " + std::to_string(covered) +
-                                             " to before the next check at " + std::to_string(nextCheck) + ", got " +
-                                             std::to_string(e.tick));
+          c.fail(at + kChunkHeaderBytes,
+                 "a final tick from " + std::to_string(covered) + " to " + std::to_string(lastAllowed) +
+                     (lastAllowed == reachable
+                          ? " (at most " + std::to_string(kMaxTickGap) + " ticks after the last tick the file names)"
+                          : " (before the next check or snapshot, due at tick " + std::to_string(nextDue) + ")") +
+                     ", got " + std::to_string(e.tick));
         r.end = e;
         break;
       }
@@ -354,19 +431,24 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
 }
 
 Recording readRecording(const std::string& path, uint64_t maxBytes) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw RecordingError(path, 0, "an existing file (not found)");
-  if (std::filesystem::is_directory(path, ec)) throw RecordingError(path, 0, "a file, not a directory");
-  const uint64_t size = std::filesystem::file_size(path, ec);
-  if (ec) throw RecordingError(path, 0, "a readable file (" + ec.message() + ")");
-  if (maxBytes == 0) maxBytes = uint64_t(1) << 34;
-  if (size > maxBytes) throw RecordingError(path, 0, "a recording of at most " + std::to_string(maxBytes) + " bytes");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw RecordingError(path, 0, "a readable file");
-  std::vector<uint8_t> bytes(size);
-  in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size));
-  if (uint64_t(in.gcount()) != size)
-    throw RecordingError(path, uint64_t(in.gcount()), "the rest of the file (read failed)");
+  if (maxBytes == 0 || maxBytes > InputLimits::kRecordingBytes) maxBytes = InputLimits::kRecordingBytes;
+  InputFile in;
+  std::string expected;
+  if (!in.open(path, maxBytes, &expected)) throw RecordingError(path, 0, expected);
+  // The preamble and the HEAD chunk's header first: a file that is no recording (or whose first
+  // chunk is not a HEAD of a sane size) is refused before the rest of it is read.
+  std::array<uint8_t, kPreambleBytes + kChunkHeaderBytes> first{};
+  const size_t firstBytes = size_t(std::min<uint64_t>(in.size(), first.size()));
+  if (!in.readAt(0, std::span<uint8_t>(first.data(), firstBytes), &expected)) throw RecordingError(path, 0, expected);
+  checkPreamble(std::span<const uint8_t>(first.data(), firstBytes), in.size(), path);
+  if (firstBytes == first.size()) {
+    const uint32_t type = loadLE<uint32_t>(first.data() + kPreambleBytes);
+    const ChunkType t =
+        checkChunkHeader(type, loadLE<uint32_t>(first.data() + kPreambleBytes + 4), kPreambleBytes, path);
+    if (t != ChunkType::Head) throw RecordingError(path, kPreambleBytes, "the HEAD chunk first");
+  }
+  std::vector<uint8_t> bytes;
+  if (!in.readAll(&bytes, &expected)) throw RecordingError(path, 0, expected);
   return parseRecording(std::move(bytes), path);
 }
 
@@ -396,16 +478,40 @@ const SnapshotInfo* Recording::snapshotAtOrBefore(int64_t tick) const {
   return it == snapshots.begin() ? nullptr : &*(it - 1);
 }
 
-std::vector<uint8_t> Recording::snapshotState(const SnapshotInfo& s) const {
+std::vector<uint8_t> Recording::snapshotState(const SnapshotInfo& s, uint64_t maxRawBytes) const {
+  // The declared size is compared with what the caller can use (the largest state of the
+  // scenario) before a byte is allocated or decompressed: a 96 KB frame of RLE blocks can expand
+  // to gigabytes.
+  const uint64_t sizeAt = s.offset >= 8 ? s.offset - 8 : s.offset;
+  if (s.rawBytes > maxRawBytes)
+    throw RecordingError(file, sizeAt,
+                         "a snapshot of at most " + std::to_string(maxRawBytes) +
+                             " bytes (the largest state this scenario can have), got " + std::to_string(s.rawBytes));
+  if (s.offset > bytes.size() || s.compressedBytes > bytes.size() - s.offset)
+    throw RecordingError(file, s.offset, "a snapshot frame inside the file");
   const uint8_t* frame = bytes.data() + s.offset;
   const unsigned long long declared = ZSTD_getFrameContentSize(frame, size_t(s.compressedBytes));
   if (declared == ZSTD_CONTENTSIZE_ERROR || declared == ZSTD_CONTENTSIZE_UNKNOWN || declared != s.rawBytes)
     throw RecordingError(file, s.offset, "a zstd frame of " + std::to_string(s.rawBytes) + " bytes");
+  // Streaming, into exactly rawBytes of output and with a bounded window: a frame that holds more
+  // than it declares (or asks for a huge window) is an error, never a larger allocation.
+  std::unique_ptr<ZSTD_DCtx, size_t (*)(ZSTD_DCtx*)> dctx(ZSTD_createDCtx(), ZSTD_freeDCtx);
+  if (!dctx) throw std::bad_alloc();
+  ZSTD_DCtx_setParameter(dctx.get(), ZSTD_d_windowLogMax, 27);
   std::vector<uint8_t> state(size_t(s.rawBytes));
-  const size_t n = ZSTD_decompress(state.data(), state.size(), frame, size_t(s.compressedBytes));
-  if (ZSTD_isError(n) || n != state.size())
-    throw RecordingError(
-        file, s.offset, std::string("a valid zstd frame (") + (ZSTD_isError(n) ? ZSTD_getErrorName(n) : "short") + ")");
+  ZSTD_inBuffer input{frame, size_t(s.compressedBytes), 0};
+  ZSTD_outBuffer output{state.data(), state.size(), 0};
+  size_t left = 1;
+  while (left != 0) {
+    const size_t before = output.pos + input.pos;
+    left = ZSTD_decompressStream(dctx.get(), &output, &input);
+    if (ZSTD_isError(left))
+      throw RecordingError(file, s.offset, std::string("a valid zstd frame (") + ZSTD_getErrorName(left) + ")");
+    if (left != 0 && output.pos + input.pos == before)  // no progress: the frame is cut or overlong
+      throw RecordingError(file, s.offset, "a valid zstd frame (short)");
+  }
+  if (output.pos != state.size() || input.pos != input.size)
+    throw RecordingError(file, s.offset, "a valid zstd frame (short)");
   return state;
 }
 

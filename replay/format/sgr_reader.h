@@ -33,13 +33,17 @@ struct Recording {
   TickInput inputAt(int64_t tick) const;
   /// Latest snapshot at or before `tick`, or nullptr.
   const SnapshotInfo* snapshotAtOrBefore(int64_t tick) const;
-  /// Decompresses a snapshot. Throws RecordingError (offset of the frame) when it is damaged.
-  std::vector<uint8_t> snapshotState(const SnapshotInfo& snapshot) const;
+  /// Decompresses a snapshot. Throws RecordingError (offset of the frame) when it is damaged, and
+  /// (offset of its size field) before anything is allocated when it declares more than
+  /// `maxRawBytes` (the Player passes the largest state its scenario can have).
+  std::vector<uint8_t> snapshotState(const SnapshotInfo& snapshot, uint64_t maxRawBytes = kMaxSnapshotRawBytes) const;
 };
 
 /// Parses recording bytes. `file` names them in errors.
 Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file);
-/// Reads and parses a file (refuses files larger than `maxBytes`, default: half the machine's memory).
+/// Reads and parses a file through InputFile (regular files only, never blocking): the preamble and
+/// the first chunk's header are checked before the rest is read. Refuses files larger than
+/// `maxBytes` (0 or more than InputLimits::kRecordingBytes: that limit).
 Recording readRecording(const std::string& path, uint64_t maxBytes = 0);
 
 }  // namespace sg::sgr

@@ -1,11 +1,14 @@
 #include "replay/format/sgr_writer.h"
+#include "replay/input_file.h"
 #include "sim/state/byte_order.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <xxhash.h>
 #include <zstd.h>
+#include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <cstring>
@@ -34,6 +37,42 @@ void putVec3(std::vector<uint8_t>& out, const InputVec3& v) {
   throw std::runtime_error(path + ": " + what + ": " + std::strerror(errno));
 }
 }  // namespace
+
+std::string headerProblem(const Header& h) {
+  auto tooLong = [](const char* what, uint64_t limit, uint64_t got) {
+    return std::string(what) + " of at most " + std::to_string(limit) + " bytes, got " + std::to_string(got);
+  };
+  if (h.variant.size() > kMaxShortString) return tooLong("variant settings", kMaxShortString, h.variant.size());
+  if (h.scenarioSource.size() > kMaxShortString)
+    return tooLong("a scenario file name", kMaxShortString, h.scenarioSource.size());
+  if (h.buildId.size() > kMaxShortString) return tooLong("a build id", kMaxShortString, h.buildId.size());
+  if (h.scenarioText.size() > InputLimits::kScenarioBytes)
+    return tooLong("a scenario text", InputLimits::kScenarioBytes, h.scenarioText.size());
+  if (h.files.size() > kMaxEmbeddedFiles)
+    return "at most " + std::to_string(kMaxEmbeddedFiles) + " embedded files, got " + std::to_string(h.files.size());
+  uint64_t total =
+      36 + 4 + h.variant.size() + 4 + h.scenarioSource.size() + 4 + h.scenarioText.size() + 4 + 4 + h.buildId.size();
+  for (const EmbeddedFile& f : h.files) {
+    if (f.name.size() > kMaxShortString) return tooLong("an embedded file name", kMaxShortString, f.name.size());
+    total += 4 + f.name.size() + 4 + f.bytes.size();
+  }
+  if (total > kMaxHeadPayload)
+    return tooLong("a HEAD chunk (scenario text and embedded files)", kMaxHeadPayload, total);
+  if (h.startTick < 0 || h.startTick > kMaxTickGap)
+    return "a start tick from 0 to " + std::to_string(kMaxTickGap) + ", got " + std::to_string(h.startTick);
+  return {};
+}
+
+std::string inputProblem(const TickInput& input) {
+  const uint64_t bytes = inputPayloadBytes(input.bodies.size(), true);
+  if (bytes > kMaxInputPayload)
+    return "at most " + std::to_string((kMaxInputPayload - inputPayloadBytes(0, true)) / (4 + 1 + 24)) +
+           " body commands in one tick (an INPT chunk holds " + std::to_string(kMaxInputPayload) + " bytes), got " +
+           std::to_string(input.bodies.size());
+  for (const BodyCommand& c : input.bodies)
+    if (c.body < 0) return "body indices >= 0, got " + std::to_string(c.body);
+  return {};
+}
 
 std::vector<uint8_t> encodeHead(const Header& h) {
   std::vector<uint8_t> out;
@@ -102,7 +141,11 @@ std::vector<uint8_t> encodeEnd(const EndInfo& e) {
   put<int64_t>(out, e.tick);
   put<uint64_t>(out, e.hash);
   put<uint8_t>(out, e.faulted ? 1 : 0);
-  putString(out, e.message);
+  // The reader takes at most kMaxShortString bytes: a longer message is shortened (on a UTF-8
+  // character boundary), never a recording the reader refuses.
+  size_t n = std::min<size_t>(e.message.size(), kMaxShortString);
+  while (n < e.message.size() && n > 0 && (uint8_t(e.message[n]) & 0xC0) == 0x80) --n;
+  putString(out, e.message.substr(0, n));
   return out;
 }
 
@@ -117,8 +160,29 @@ std::vector<uint8_t> frameChunk(ChunkType type, std::span<const uint8_t> payload
 }
 
 Writer::Writer(const std::string& path, const Header& header) : path_(path) {
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd_ < 0) ioFail(path, "cannot create the recording");
+  // Checked before the file is created: a recording the reader would refuse is never started.
+  if (const std::string why = headerProblem(header); !why.empty())
+    throw std::runtime_error(path + ": cannot record: expected " + why);
+  // O_NONBLOCK: opening a FIFO for writing would wait for a reader for ever; it is refused below
+  // (a recording is a file to read back), as is anything but a regular file or a device.
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | O_NONBLOCK | O_NOCTTY, 0644);
+  if (fd_ < 0) {
+    if (errno == ENXIO) errno = EINVAL;  // a FIFO without a reader
+    ioFail(path, "cannot create the recording");
+  }
+  struct stat st {};
+  if (::fstat(fd_, &st) != 0 || !(S_ISREG(st.st_mode) || S_ISCHR(st.st_mode))) {
+    ::close(fd_);
+    fd_ = -1;
+    throw std::runtime_error(path + ": cannot create the recording: expected a regular file, not a FIFO or socket");
+  }
+  if (S_ISREG(st.st_mode) && ::ftruncate(fd_, 0) != 0) {
+    ::close(fd_);
+    fd_ = -1;
+    ioFail(path, "cannot create the recording");
+  }
+  const int flags = ::fcntl(fd_, F_GETFL);
+  if (flags >= 0) ::fcntl(fd_, F_SETFL, flags & ~O_NONBLOCK);
   pending_.insert(pending_.end(), std::begin(kMagic), std::end(kMagic));
   put<uint32_t>(pending_, kFormatVersion);
   append(ChunkType::Head, encodeHead(header));
@@ -128,7 +192,7 @@ Writer::Writer(const std::string& path, const Header& header) : path_(path) {
 Writer::~Writer() {
   if (fd_ >= 0) {
     try {
-      flush();
+      if (!failed_) flush();
     } catch (...) {  // a destructor must not throw; the file stays readable up to here
     }
     ::close(fd_);
@@ -137,27 +201,42 @@ Writer::~Writer() {
 
 void Writer::append(ChunkType type, std::span<const uint8_t> payload) {
   if (fd_ < 0) throw std::runtime_error(path_ + ": the recording is already closed");
+  if (failed_) throw std::runtime_error(path_ + ": the recording stopped at an earlier write error");
   const std::vector<uint8_t> chunk = frameChunk(type, payload);
   pending_.insert(pending_.end(), chunk.begin(), chunk.end());
 }
 
-void Writer::input(int64_t tick, const TickInput& in) {
+bool Writer::input(int64_t tick, const TickInput& in) {
   const bool cameraChanged = in.hasCamera != previous_.hasCamera || in.camera != previous_.camera;
-  if (cameraChanged || !in.bodies.empty()) append(ChunkType::Input, encodeInput(tick, in, previous_));
+  if (const std::string why = inputProblem(in); !why.empty())
+    throw std::runtime_error(path_ + ": cannot record the input of tick " + std::to_string(tick) + ": expected " + why);
+  const bool written = cameraChanged || !in.bodies.empty();
+  if (written) append(ChunkType::Input, encodeInput(tick, in, previous_));
   previous_.hasCamera = in.hasCamera;
   previous_.camera = in.camera;
+  return written;
 }
 
 void Writer::check(const Check& c) { append(ChunkType::Check, encodeCheck(c)); }
 
 void Writer::snapshot(int64_t tick, uint64_t hash, std::span<const uint8_t> state) {
-  append(ChunkType::Snapshot, encodeSnapshot(tick, hash, state, zstdLevel));
+  if (state.size() > kMaxSnapshotRawBytes)
+    throw std::runtime_error(path_ + ": cannot record a snapshot of " + std::to_string(state.size()) +
+                             " bytes (a SNAP chunk holds at most " + std::to_string(kMaxSnapshotRawBytes) + ")");
+  const std::vector<uint8_t> payload = encodeSnapshot(tick, hash, state, zstdLevel);
+  if (payload.size() > kMaxSnapshotPayload)
+    throw std::runtime_error(path_ + ": cannot record a snapshot that compresses to " + std::to_string(payload.size()) +
+                             " bytes (a SNAP chunk holds at most " + std::to_string(kMaxSnapshotPayload) + ")");
+  append(ChunkType::Snapshot, payload);
 }
 
 void Writer::end(const EndInfo& e) {
   append(ChunkType::End, encodeEnd(e));
   flush();
-  if (::fsync(fd_) != 0 && errno != EINVAL) ioFail(path_, "cannot sync the recording");
+  if (::fsync(fd_) != 0 && errno != EINVAL) {
+    failed_ = true;
+    ioFail(path_, "cannot sync the recording");
+  }
   if (::close(fd_) != 0) {
     fd_ = -1;
     ioFail(path_, "cannot close the recording");
@@ -166,11 +245,17 @@ void Writer::end(const EndInfo& e) {
 }
 
 void Writer::flush() {
+  if (fd_ < 0) throw std::runtime_error(path_ + ": the recording is already closed");
+  if (failed_) throw std::runtime_error(path_ + ": the recording stopped at an earlier write error");
   size_t done = 0;
   while (done < pending_.size()) {
     const ssize_t n = ::write(fd_, pending_.data() + done, pending_.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      // The file now ends inside a chunk at worst (it reads as cut off there); nothing more is
+      // written, so a retry can never append a second copy of a half-written chunk.
+      if (n == 0) errno = EIO;
+      failed_ = true;
       ioFail(path_, "cannot write the recording");
     }
     done += size_t(n);

@@ -9,6 +9,8 @@
 
 #include <stb_image_write.h>
 
+#include "replay/output_file.h"
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-function"
 #include <stb_easy_font.h>
@@ -263,10 +265,31 @@ Image render(const ScatterPlot& plot) {
   return std::move(c.img);
 }
 
+std::vector<uint8_t> encodePng(const Image& image) {
+  std::vector<uint8_t> png;
+  if (image.width <= 0 || image.height <= 0 || image.rgb.size() != size_t(image.width) * size_t(image.height) * 3)
+    return png;
+  // stb's callback writer: the PNG in memory, so that writing it to disk is writeFileAtomic's
+  // (every write checked; a full disk is an error, not a truncated file).
+  auto append = [](void* context, void* data, int size) {
+    auto* out = static_cast<std::vector<uint8_t>*>(context);
+    const auto* bytes = static_cast<const uint8_t*>(data);
+    out->insert(out->end(), bytes, bytes + size);
+  };
+  if (!stbi_write_png_to_func(append, &png, image.width, image.height, 3, image.rgb.data(), image.width * 3))
+    png.clear();
+  return png;
+}
+
 bool writePng(const std::string& path, const Image& image, std::string* error) {
-  if (image.width <= 0 || image.height <= 0 ||
-      !stbi_write_png(path.c_str(), image.width, image.height, 3, image.rgb.data(), image.width * 3)) {
-    if (error) *error = path + ": expected a writable PNG file (cannot write it)";
+  const std::vector<uint8_t> png = encodePng(image);
+  if (png.empty()) {
+    if (error) *error = path + ": cannot encode the PNG image";
+    return false;
+  }
+  std::string why;
+  if (!writeFileAtomic(path, png, &why)) {
+    if (error) *error = why;
     return false;
   }
   return true;

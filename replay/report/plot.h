@@ -84,7 +84,10 @@ struct Canvas {
 
 Image render(const ScatterPlot& plot);
 
-/// Writes a PNG; false with `error` set ("path: expected a writable PNG file") when it cannot.
+/// The image as PNG bytes (empty when it cannot be encoded).
+std::vector<uint8_t> encodePng(const Image& image);
+/// Writes a PNG with writeFileAtomic (complete or absent); false with `error` set ("path: cannot
+/// write (No space left on device)") when it cannot.
 bool writePng(const std::string& path, const Image& image, std::string* error);
 
 /// A short number for tick labels: "1e-3", "0.01", "100", "1e5".

@@ -297,7 +297,7 @@ def build(data):
     forged = replace_chunk(data, last_inpt,
                            frame(b"INPT", struct.pack("<q", int64_max) + payload(data, last_inpt)[8:]))
     add("inpt-tick-max.sgr", "end-field", forged,
-        {"outcome": "error", "offset": end[0] + 8, "message": f"a final tick from {int64_max}"})
+        {"outcome": "error", "offset": last_inpt[0] + 8, "message": f"an input tick at most {1 << 16} ticks after"})
     no_hashes = bytearray(payload(data, cs[0]))
     no_hashes[4:12] = struct.pack("<II", 0, 0)  # checkEvery, snapshotEvery
     kept = [c for c in cs[1:] if c[1] in (b"INPT", b"END ")]
@@ -306,6 +306,35 @@ def build(data):
         data[c[0]:c[0] + 16 + c[2]] for c in kept if c[1] == b"INPT") + faulted
     add("end-faulted-tick-max.sgr", "end-field", blob,
         {"outcome": "error", "offset": len(blob) - len(faulted) + 8, "message": "a final tick from"})
+
+    # Chunks the header promises, missing (valid checksums): every SNAP removed, every CHCK removed.
+    no_snaps = data[:PREAMBLE] + b"".join(data[c[0]:c[0] + 16 + c[2]] for c in cs if c[1] != b"SNAP")
+    first_check = [c for c in cs if c[1] == b"CHCK"]
+    snap_tick = struct.unpack_from("<q", payload(data, first[b"SNAP"]), 0)[0]
+    check_at = next(c for c in first_check if struct.unpack_from("<q", payload(data, c), 0)[0] == snap_tick)
+    removed_before = sum(16 + c[2] for c in cs if c[1] == b"SNAP" and c[0] < check_at[0])
+    add("missing-snapshots.sgr", "missing-chunk", no_snaps,
+        {"outcome": "error", "offset": check_at[0] - removed_before + 8,
+         "message": f"the SNAP chunk of tick {snap_tick} before the check of tick {snap_tick}"})
+    no_checks = data[:PREAMBLE] + b"".join(data[c[0]:c[0] + 16 + c[2]] for c in cs if c[1] != b"CHCK")
+    first_input_after = next(c for c in cs if c[1] == b"INPT" and struct.unpack_from("<q", payload(data, c), 0)[0] >= 1)
+    removed_before = sum(16 + c[2] for c in cs if c[1] == b"CHCK" and c[0] < first_input_after[0])
+    add("missing-checks.sgr", "missing-chunk", no_checks,
+        {"outcome": "error", "offset": first_input_after[0] - removed_before + 8,
+         "message": "the CHCK chunk of tick 1 before the input of tick"})
+
+    # Ticks no replay could reach in reasonable time (hashes off, so no interval bounds them).
+    gap = 1 << 16
+    unbounded_end = frame(b"END ", struct.pack("<qQB", 1 << 40, 0, 0) + struct.pack("<I", 0))
+    blob = data[:PREAMBLE] + frame(b"HEAD", bytes(no_hashes)) + b"".join(
+        data[c[0]:c[0] + 16 + c[2]] for c in kept if c[1] == b"INPT") + unbounded_end
+    add("end-tick-unbounded.sgr", "tick-span", blob,
+        {"outcome": "error", "offset": len(blob) - len(unbounded_end) + 8,
+         "message": f"(at most {gap} ticks after the last tick the file names)"})
+    far_start = bytearray(payload(data, cs[0]))
+    far_start[28:36] = struct.pack("<q", 1 << 40)
+    add("start-tick-far.sgr", "tick-span", replace_chunk(data, cs[0], frame(b"HEAD", bytes(far_start))),
+        {"outcome": "error", "offset": PREAMBLE + 8 + 28, "message": f"a start tick from 0 to {gap}"})
 
     hp = payload(data, cs[0])
     text_at, _ = head_fields(hp)["text"]
