@@ -442,11 +442,12 @@ TEST(RecordingLimits, ARecordingMissingItsLastSnapshotOrItsChecksIsDamaged) {
 }
 
 TEST(RecordingLimits, ARecordingThatFaultedOnItsLastInputVerifies) {
-  // The command of tick 2 makes the ball's velocity overflow in the step from tick 2: END (faulted,
+  // The command of tick 2 (within the input range, so accepted at load) makes the ball's velocity
+  // overflow in the step from tick 2: END (faulted,
   // tick 2) follows the INPT of tick 2. Such a recording was refused as "a final tick from 3".
   TempDir dir;
   nlohmann::json s = nlohmann::json::parse(readFile(tinyScenario()));
-  s["script"] = {{{"tick", 2}, {"body", "ball"}, {"command", "addVelocity"}, {"value", {1e9, 1e9, 1e9}}}};
+  s["script"] = {{{"tick", 2}, {"body", "ball"}, {"command", "addVelocity"}, {"value", {5e8, 5e8, 5e8}}}};
   const std::string scenario = dir.write("fault.json", s.dump());
   const std::string out = dir.file("fault.sgr");
   const CliResult rec = runCli("record " + quote(scenario) + " -o " + quote(out) + " --ticks 20");

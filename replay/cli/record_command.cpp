@@ -151,8 +151,7 @@ int record(const RecordOptions& o) {
   }
   if (!last.ok) {
     // Name the input behind a body's fault (its file and JSON path), as `run` does.
-    const std::string cause =
-        describeInputCause(scenario, track ? &*track : nullptr, last.error.tick, last.error.body);
+    const std::string cause = describeInputCause(scenario, track ? &*track : nullptr, last.error.tick, last.error.body);
     printError("simgrass record: %s%s (recorded up to it)\n", last.error.message().c_str(),
                cause.empty() ? "" : ("; " + cause).c_str());
     return kExitMismatch;

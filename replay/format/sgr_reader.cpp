@@ -452,6 +452,14 @@ Recording readRecording(const std::string& path, uint64_t maxBytes) {
   return parseRecording(std::move(bytes), path);
 }
 
+bool hasRecordingMagic(const std::string& path) {
+  InputFile in;
+  std::string expected;
+  uint8_t magic[sizeof kMagic] = {};
+  return in.open(path, InputLimits::kRecordingBytes, &expected) && in.size() >= sizeof magic &&
+         in.readAt(0, magic, &expected) && std::memcmp(magic, kMagic, sizeof magic) == 0;
+}
+
 int64_t Recording::lastTick() const {
   if (end) return end->tick;
   int64_t t = header.startTick;

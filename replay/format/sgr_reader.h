@@ -46,4 +46,9 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file);
 /// `maxBytes` (0 or more than InputLimits::kRecordingBytes: that limit).
 Recording readRecording(const std::string& path, uint64_t maxBytes = 0);
 
+/// Whether `path` is a regular file that starts with the recording magic (read through InputFile:
+/// a FIFO, a directory or a device is not a recording, and probing it never blocks). How the
+/// viewer and `simgrass render` tell a recording from a scenario.
+bool hasRecordingMagic(const std::string& path);
+
 }  // namespace sg::sgr

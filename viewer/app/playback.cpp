@@ -15,28 +15,16 @@
 namespace sg::viewer {
 
 bool looksLikeRecording(const std::string& path) {
+  // A `.sgr` name is a recording (its reader names what is wrong with it); otherwise the magic
+  // decides, probed without blocking (sgr::hasRecordingMagic).
   if (path.size() >= 4 && path.compare(path.size() - 4, 4, ".sgr") == 0) return true;
-  // The bounded reader: a FIFO, a directory or a device is no recording (and opening it never
-  // blocks); the scenario loader then names what it is.
-  InputFile in;
-  std::string expected;
-  uint8_t magic[sizeof sgr::kMagic] = {};
-  return in.open(path, InputLimits::kRecordingBytes, &expected) && in.size() >= sizeof magic &&
-         in.readAt(0, magic, &expected) && std::memcmp(magic, sgr::kMagic, sizeof magic) == 0;
-}
-
-sgr::Recording readRecordingFile(const std::string& path) {
-  std::vector<uint8_t> bytes;
-  std::string expected;
-  if (!readInputFile(path, InputLimits::kRecordingBytes, &bytes, &expected))
-    throw sgr::RecordingError(path, 0, expected);
-  return sgr::parseRecording(std::move(bytes), path);
+  return sgr::hasRecordingMagic(path);
 }
 
 std::unique_ptr<Playback> Playback::open(const std::string& path, int threads) {
   std::unique_ptr<Playback> p(new Playback());
   p->threads_ = threads;
-  p->rec_ = std::make_unique<sgr::Recording>(readRecordingFile(path));
+  p->rec_ = std::make_unique<sgr::Recording>(sgr::readRecording(path));
   if (p->rec_->truncated)  // the CLI's warning: what is there still plays
     std::fprintf(stderr,
                  "simgrass-viewer: warning: %s: byte %" PRIu64 ": expected %s; playing the %" PRId64
@@ -50,7 +38,7 @@ std::unique_ptr<Playback> Playback::open(const std::string& path, int threads) {
 }
 
 void Playback::attachRecording(const std::string& path) {
-  recB_ = std::make_unique<sgr::Recording>(readRecordingFile(path));
+  recB_ = std::make_unique<sgr::Recording>(sgr::readRecording(path));
   const Rational dtA = recordedTimeStep(*rec_), dtB = recordedTimeStep(*recB_);
   if (!(dtA == dtB))
     throw std::invalid_argument(path + ": expected a recording with A's time step " + dtA.toString() + ", got " +

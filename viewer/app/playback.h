@@ -17,9 +17,6 @@ namespace sg::viewer {
 
 /// True for a path ending in ".sgr" or a file starting with the recording magic.
 bool looksLikeRecording(const std::string& path);
-/// Reads a recording through the bounded reader (replay/input_file.h) and parses it. Throws
-/// sgr::RecordingError ("file: byte 0: expected a regular file, got a FIFO" and the parser's lines).
-sgr::Recording readRecordingFile(const std::string& path);
 
 class Playback {
  public:

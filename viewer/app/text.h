@@ -28,11 +28,11 @@ namespace sg::viewer {
 
 /// Bounds on what a user edits in the viewer (`set`, panels; docs/viewer.md "Limits").
 struct EditLimits {
-  static constexpr int kJsonDepth = kMaxJsonDepth;                   ///< nesting of a `set` value (and the edited path)
+  static constexpr int kJsonDepth = kMaxJsonDepth;          ///< nesting of a `set` value (and the edited path)
   static constexpr size_t kPathSegments = 16;               ///< segments of a `set` path ("a.b.c")
   static constexpr size_t kPathChars = 256;                 ///< length of a `set` path
   static constexpr size_t kArrayEntries = size_t(1) << 16;  ///< entries an edited array may grow to
-  static constexpr size_t kShownChars = kEchoChars;               ///< echoed user text in messages
+  static constexpr size_t kShownChars = kEchoChars;         ///< echoed user text in messages
 };
 
 /// User text quoted in a one-line message (sim/scenario/json_bounds.h echoText: control

@@ -139,24 +139,6 @@ std::optional<viewer::Camera> parseCamera(const std::string& s) {
   return c;
 }
 
-/// A file starting with the recording magic, opened through the bounded reader (a FIFO, a
-/// directory or a device is not a recording: the scenario loader then names what it is).
-bool isRecording(const std::string& path) {
-  InputFile in;
-  std::string expected;
-  uint8_t magic[sizeof sgr::kMagic] = {};
-  return in.open(path, InputLimits::kRecordingBytes, &expected) && in.size() >= sizeof magic &&
-         in.readAt(0, magic, &expected) && std::equal(std::begin(magic), std::end(magic), std::begin(sgr::kMagic));
-}
-
-sgr::Recording readRecordingFile(const std::string& path) {
-  std::vector<uint8_t> bytes;
-  std::string expected;
-  if (!readInputFile(path, InputLimits::kRecordingBytes, &bytes, &expected))
-    throw sgr::RecordingError(path, 0, expected);
-  return sgr::parseRecording(std::move(bytes), path);
-}
-
 double rawToMetres(int64_t raw) { return double(raw) / 4294967296.0; }
 
 /// The camera of the input track at the frame: at the input camera, looking where the track goes
@@ -336,8 +318,8 @@ int render(const RenderOptions& o) {
   std::unique_ptr<sgr::Recording> recording;
   std::unique_ptr<Player> player;
   try {
-    if (isRecording(o.input)) {
-      recording = std::make_unique<sgr::Recording>(readRecordingFile(o.input));
+    if (sgr::hasRecordingMagic(o.input)) {
+      recording = std::make_unique<sgr::Recording>(sgr::readRecording(o.input));
       player = std::make_unique<Player>(*recording, o.threads);
       scenario = player->scenario();
       if (range->last > recording->lastTick())
