@@ -43,8 +43,8 @@ Bytes deflate(const Bytes& raw) {
 struct Png {
   uint32_t width = 4, height = 3;
   uint8_t depth = 8, colour = 0, interlace = 0;
-  Bytes raw;                      ///< the filtered scanlines (filter byte 0 + row)
-  std::vector<Bytes> before;      ///< extra chunks before IDAT, each "TYPE" + data
+  Bytes raw;                  ///< the filtered scanlines (filter byte 0 + row)
+  std::vector<Bytes> before;  ///< extra chunks before IDAT, each "TYPE" + data
   bool iend = true;
 
   Bytes ihdr() const {
@@ -207,8 +207,8 @@ TEST(HeightmapPng, OtherDepthsAndColourTypesAreRefusedBeforeDecoding) {
   const struct {
     uint8_t depth, colour;
     const char* phrase;
-  } cases[] = {{1, 0, "1-bit grayscale"},   {2, 0, "2-bit grayscale"},    {4, 0, "4-bit grayscale"},
-               {16, 0, "16-bit grayscale"}, {8, 3, "8-bit palette"},      {4, 3, "4-bit palette"},
+  } cases[] = {{1, 0, "1-bit grayscale"},   {2, 0, "2-bit grayscale"},       {4, 0, "4-bit grayscale"},
+               {16, 0, "16-bit grayscale"}, {8, 3, "8-bit palette"},         {4, 3, "4-bit palette"},
                {8, 2, "8-bit RGB"},         {8, 4, "8-bit grayscale+alpha"}, {8, 6, "8-bit RGBA"},
                {16, 2, "16-bit RGB"}};
   for (const auto& c : cases) {
@@ -229,8 +229,8 @@ TEST(HeightmapPng, SizesOutsideTheBoundsAreRefusedBeforeDecoding) {
   for (const auto& c : cases) {
     Png p = gray8(4, 3);
     p.width = c.w, p.height = c.h;
-    expectRefused(p.bytes(), "a heightmap between 2x2 and 16384x16384 samples, got " + std::to_string(c.w) +
-                                 "x" + std::to_string(c.h));
+    expectRefused(p.bytes(), "a heightmap between 2x2 and 16384x16384 samples, got " + std::to_string(c.w) + "x" +
+                                 std::to_string(c.h));
   }
   Png zero = gray8(4, 3);
   zero.width = 0;
