@@ -319,6 +319,26 @@ TEST(BadFloatState, NonFiniteOrHugeValuesAreRefusedAtTheirByte) {
   }
 }
 
+// A body's still-tick count outside 0..ticksToSleep was silently clamped to 0 (a negative one),
+// or overflowed the next count (INT32_MAX): refused at its byte. Found by state_restore_fuzz.
+TEST(BadBodyState, StillTickCountOutOfRangeIsRefusedAtItsByte) {
+  auto world = build({"thesis-bodies", "fx32"}, 1);
+  runTicks(*world, 3);
+  const std::vector<uint8_t> good = world->saveState();
+  const size_t at = test::findSection(good, "BODY").payloadAt + 13 * sizeof(int64_t);  // body 0's count
+  for (const int32_t bad : {-1, INT32_MIN, INT32_MAX}) {
+    auto b = good;
+    std::memcpy(&b[at], &bad, 4);
+    try {
+      world->restoreState(b);
+      ADD_FAILURE() << "accepted a still-tick count of " << bad;
+    } catch (const StateError& e) {
+      EXPECT_EQ(e.offset(), at) << e.what();
+      EXPECT_NE(std::string(e.what()).find("a still-tick count from 0 to "), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST_F(BadState, FailedRestoreLeavesTheWorldUsable) {
   auto b = good;
   b[0] = 'X';

@@ -172,7 +172,14 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
     r.at = bodySection.offset();
     checkFloatValues<S>(bodySection, 13, "body pose or velocity");
     bodySection.readArray(r.v, 13, "a body's pose and velocities");
+    const uint64_t stillAt = bodySection.offset();
     r.stillTicks = bodySection.read<int32_t>("a body's still-tick count");
+    // A running world counts an awake body's still ticks up to ticksToSleep, where it falls asleep
+    // and the count stops; anything else was never saved (and INT32_MAX would overflow the count).
+    const int32_t maxStill = std::max<int32_t>(ticksToSleep_, 1);
+    if (r.stillTicks < 0 || r.stillTicks > maxStill)
+      throw StateError(stillAt, "a still-tick count from 0 to " + std::to_string(maxStill) + ", got " +
+                                    std::to_string(r.stillTicks));
     const uint64_t flagsAt = bodySection.offset();
     r.flags = bodySection.read<uint8_t>("a body's flags");
     if (r.flags & ~(kBodyAsleep | kBodyBladeOff)) throw StateError(flagsAt, "body flags 0 to 3");
@@ -283,7 +290,7 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
     b.orientation = Quat<S>(r.v[3], r.v[4], r.v[5], r.v[6]);
     b.velocity = Vec3<S>(r.v[7], r.v[8], r.v[9]);
     b.angularVelocity = Vec3<S>(r.v[10], r.v[11], r.v[12]);
-    b.stillTicks = r.stillTicks < 0 ? 0 : r.stillTicks;
+    b.stillTicks = r.stillTicks;
     b.asleep = (r.flags & kBodyAsleep) != 0;
     b.bladeOn = (r.flags & kBodyBladeOff) == 0;
     b.updateDerived();
