@@ -3,6 +3,7 @@
 // for states that do not belong to the world.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -268,6 +269,76 @@ TEST_F(BadState, FieldsAreLittleEndianWhateverTheHost) {
   EXPECT_EQ(int64_t(particles), world->counts().particles());
   EXPECT_EQ(std::string(reinterpret_cast<const char*>(good.data()), 12), std::string("SGSTATE2HEAD"));
 }
+// Float and double states: a NaN, an infinity or a 1e45 restored would reach the next step as
+// undefined behaviour (a float-to-int64 cell lookup), not as a fault; refused at its byte, with
+// the world left as it was. Found by tests/fuzz/state_restore_fuzz (its crashes/ folder).
+TEST(BadFloatState, NonFiniteOrHugeValuesAreRefusedAtTheirByte) {
+  for (const char* scalar : {"double", "float"}) {
+    SCOPED_TRACE(scalar);
+    auto world = build({"thesis-bodies", scalar}, 1);
+    runTicks(*world, 3);
+    const std::vector<uint8_t> good = world->saveState();
+    const size_t width = std::string(scalar) == "double" ? 8 : 4;
+    auto poke = [&](std::vector<uint8_t>& b, size_t at, double v) {
+      if (width == 8) {
+        std::memcpy(&b[at], &v, 8);
+      } else {
+        const float f = float(v);
+        std::memcpy(&b[at], &f, 4);
+      }
+    };
+    const struct {
+      const char* section;
+      size_t value;  ///< which value of the section's payload
+      double v;
+      const char* fragment;
+    } cases[] = {{"PART", 0, std::nan(""), "a finite particle position or velocity within +-2^48"},
+                 {"PART", 7, -INFINITY, "a finite particle position or velocity within +-2^48"},
+                 {"PART", 3, 3e14, "a finite particle position or velocity within +-2^48"},
+                 {"BODY", 0, -2.4e37, "a finite body pose or velocity within +-2^48"},
+                 {"BODY", 9, std::nan(""), "a finite body pose or velocity within +-2^48"}};
+    for (const auto& c : cases) {
+      auto b = good;
+      const size_t at = test::findSection(b, c.section).payloadAt + c.value * width;
+      poke(b, at, c.v);
+      const uint64_t before = world->stateHash();
+      try {
+        world->restoreState(b);
+        ADD_FAILURE() << "accepted " << c.v << " in " << c.section;
+      } catch (const StateError& e) {
+        EXPECT_EQ(e.offset(), at) << e.what();
+        EXPECT_NE(std::string(e.what()).find(c.fragment), std::string::npos) << e.what();
+      }
+      EXPECT_EQ(world->stateHash(), before);
+    }
+    // 2^48 itself is allowed (and a plain restore of the saved state still works).
+    auto edge = good;
+    poke(edge, test::findSection(edge, "PART").payloadAt, 281474976710656.0);
+    EXPECT_NO_THROW(world->restoreState(edge));
+    EXPECT_NO_THROW(world->restoreState(good));
+  }
+}
+
+// A body's still-tick count outside 0..ticksToSleep was silently clamped to 0 (a negative one),
+// or overflowed the next count (INT32_MAX): refused at its byte. Found by state_restore_fuzz.
+TEST(BadBodyState, StillTickCountOutOfRangeIsRefusedAtItsByte) {
+  auto world = build({"thesis-bodies", "fx32"}, 1);
+  runTicks(*world, 3);
+  const std::vector<uint8_t> good = world->saveState();
+  const size_t at = test::findSection(good, "BODY").payloadAt + 13 * sizeof(int64_t);  // body 0's count
+  for (const int32_t bad : {-1, INT32_MIN, INT32_MAX}) {
+    auto b = good;
+    std::memcpy(&b[at], &bad, 4);
+    try {
+      world->restoreState(b);
+      ADD_FAILURE() << "accepted a still-tick count of " << bad;
+    } catch (const StateError& e) {
+      EXPECT_EQ(e.offset(), at) << e.what();
+      EXPECT_NE(std::string(e.what()).find("a still-tick count from 0 to "), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST_F(BadState, FailedRestoreLeavesTheWorldUsable) {
   auto b = good;
   b[0] = 'X';

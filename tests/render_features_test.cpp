@@ -181,6 +181,76 @@ TEST(RenderObj, BadFilesGiveOneLineWithTheirLineNumber) {
   }
 }
 
+/// parseObjMesh's error for `text` ("" when it was accepted).
+std::string objError(const std::string& text) {
+  viewer::ObjMesh mesh;
+  std::string error;
+  return viewer::parseObjMesh(text, "m.obj", &mesh, &error) ? std::string() : error;
+}
+
+TEST(RenderObj, NumbersOutOfRangeOrNotFiniteAreRefused) {
+  // from_chars reports overflow; NaN and infinity parse but are refused; so is a coordinate past
+  // 1e6 m (its normal sums would overflow float).
+  for (const char* bad : {"1e39", "-1e39", "nan", "inf", "-inf", "1e7", "-1000001", "0x10", "1.5.2", "+1"}) {
+    const std::string e = objError(std::string("v 0 0 0\nv 1 0 0\nv 0 ") + bad + " 0\nf 1 2 3\n");
+    EXPECT_EQ(e.rfind("m.obj:3: expected a finite number within +-1e6, got '", 0), size_t(0)) << bad << ": " << e;
+  }
+  EXPECT_EQ(objError("v 0 0 0\nv 1e6 0 0\nv 0 -1e6 0\nf 1 2 3\n"), "") << "the bound itself is allowed";
+  EXPECT_EQ(
+      objError("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n").rfind("m.obj:4: expected a vertex index", 0),
+      size_t(0))
+      << "an index past int64 is an error, not a wrapped number";
+}
+
+TEST(RenderObj, EchoedWordsAreShortAndEscaped) {
+  const std::string e = objError("v 0 0 " + std::string(100000, '7') + "x\n");
+  EXPECT_LT(e.size(), size_t(200)) << e;
+  EXPECT_NE(e.find("7777..."), std::string::npos) << e;
+  const std::string c = objError(std::string("v 0 0 1\x01\x1b[2J\n"));
+  EXPECT_NE(c.find("'1\\x01\\x1b[2J'"), std::string::npos) << c;
+  EXPECT_EQ(c.find('\x1b'), std::string::npos) << "no raw control characters";
+}
+
+TEST(RenderObj, TriangleCountIsBoundedBeforeTheCornersAreRead) {
+  // One face of 4 000 003 corners would be 4 000 001 triangles (192 MiB of corners): refused at
+  // its line. 4 000 002 corners (the bound) are read.
+  std::string text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf";
+  for (int i = 0; i < 4'000'003; ++i) text += " 1";
+  const std::string e = objError(text + "\n");
+  EXPECT_EQ(e, "m.obj:4: expected at most 4000000 triangles in the mesh");
+  text.resize(text.size() - 2);
+  viewer::ObjMesh mesh;
+  std::string error;
+  ASSERT_TRUE(viewer::parseObjMesh(text, "m.obj", &mesh, &error)) << error;
+  EXPECT_EQ(mesh.triangles(), size_t(4'000'000));
+  // The bound is over the whole mesh, not per face.
+  EXPECT_EQ(objError(text + "\nf 1 2 3\n"), "m.obj:5: expected at most 4000000 triangles in the mesh");
+}
+
+TEST(RenderObj, OnePositionWithManyNormalsGivesOneVertexPerPair) {
+  // 1//1, 1//2 and 1//1 again: two output vertices for position 1 (a map keyed by the pair).
+  viewer::ObjMesh mesh;
+  std::string error;
+  ASSERT_TRUE(
+      viewer::parseObjMesh("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 1 0\n"
+                           "f 1//1 2//1 3//1\nf 1//2 2//1 3//1\nf 1//1 3//1 2//1\n",
+                           "m.obj", &mesh, &error))
+      << error;
+  EXPECT_EQ(mesh.positions.size() / 3, size_t(4));
+  EXPECT_EQ(mesh.indices[0], mesh.indices[6]);
+  EXPECT_NE(mesh.indices[0], mesh.indices[3]);
+}
+
+TEST(RenderObj, LoadReadsOnlyBoundedRegularFiles) {
+  // A directory (and, by readInputFile, a FIFO or device): refused at line 0 before any read.
+  viewer::ObjMesh mesh;
+  std::string error;
+  EXPECT_FALSE(viewer::loadObjMesh(objPath(""), &mesh, &error));
+  EXPECT_NE(error.find(":0: expected a regular file, got a directory"), std::string::npos) << error;
+  EXPECT_FALSE(viewer::loadObjMesh("/dev/zero", &mesh, &error));
+  EXPECT_NE(error.find(":0: expected a regular file"), std::string::npos) << error;
+}
+
 TEST(RenderObj, RandomBytesNeverCrash) {
   uint64_t state = 12345;
   auto next = [&] { return state = state * 6364136223846793005ull + 1442695040888963407ull; };

@@ -15,8 +15,14 @@ set(CMAKE_CXX_COMPILER ${SG_CROSS_GNU}-g++)
 set(CMAKE_LIBRARY_ARCHITECTURE ${SG_CROSS_MULTIARCH})
 set(CMAKE_CROSSCOMPILING_EMULATOR ${SG_CROSS_EMULATOR})
 
-# pkg-config: the target's .pc files only (never the build machine's x86-64 ones).
+# pkg-config: the target's .pc files only (never the build machine's x86-64 ones). SG_PNG_DEPS
+# (-DSG_PNG_DEPS=DIR, .ci/cross-check): libspng + zlib compiled for the target from Debian's
+# sources (libspng-dev is not Multi-Arch: same, so it has no multiarch package to install).
+list(APPEND CMAKE_TRY_COMPILE_PLATFORM_VARIABLES SG_PNG_DEPS)
 set(ENV{PKG_CONFIG_LIBDIR} /usr/lib/${SG_CROSS_MULTIARCH}/pkgconfig:/usr/share/pkgconfig)
+if(SG_PNG_DEPS)
+  set(ENV{PKG_CONFIG_LIBDIR} ${SG_PNG_DEPS}/lib/pkgconfig:$ENV{PKG_CONFIG_LIBDIR})
+endif()
 unset(ENV{PKG_CONFIG_PATH})
 
 # find_package/find_library: the cross compiler's own tree first, then the multiarch

@@ -2,9 +2,10 @@
 #
 # SG_WASM_DEPS (required, -DSG_WASM_DEPS=DIR): a prefix that .ci/cross-check fills with the
 # dependencies built for wasm32 and copies of the header-only ones:
-#   include/    zstd.h, xxhash.h, stb/, nlohmann/, CLI/
-#   lib/        libzstd.a, libxxhash.a, libstb.a (compiled with emcc from Debian's sources/headers)
-#   lib/pkgconfig/{libxxhash,stb}.pc, lib/cmake/zstd/, share/cmake/{nlohmann_json,CLI11}/
+#   include/    zstd.h, xxhash.h, spng.h, zlib.h, stb/, nlohmann/, CLI/
+#   lib/        libzstd.a, libxxhash.a, libstb.a, libspng.a, libz.a (compiled with emcc from
+#               Debian's sources/headers)
+#   lib/pkgconfig/{libxxhash,stb,spng}.pc, lib/cmake/zstd/, share/cmake/{nlohmann_json,CLI11}/
 # Nothing is taken from the build machine's /usr/include itself: an -isystem /usr/include would
 # put glibc's headers in front of emscripten's libc. Eigen is header-only in its own directory
 # (/usr/include/eigen3), so Debian's package is used as it is.

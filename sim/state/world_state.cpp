@@ -18,6 +18,26 @@ void putSection(StateSink& sink, Section section, uint64_t payloadBytes) {
   sink.write(state::kSectionTags[int(section)], 4);
   sink.put(payloadBytes);
 }
+
+/// The largest magnitude a float or double state may hold (m, m/s, rad/s, N s): 2^48, far past
+/// any world that can be saved (fx32's whole range is 2^31), and small enough that the next
+/// step's integer cell lookups (floorToInt of a position over a spacing) cannot overflow int64.
+constexpr double kMaxFloatStateMagnitude = 281474976710656.0;  // 2^48
+
+/// Float and double states: n values at the cursor, each finite and within +-2^48 (a NaN or a
+/// 1e45 in a restored state would reach the step as undefined behaviour, not as a fault). Fixed
+/// states need no check: every raw value is a value of the type. Reads a copy of the cursor.
+template <class S>
+void checkFloatValues(state::Cursor at, uint64_t n, const char* what) {
+  if constexpr (!ScalarTraits<S>::isFixed) {
+    for (uint64_t i = 0; i < n; ++i) {
+      const uint64_t offset = at.offset();
+      const double v = double(at.read<S>(what));
+      if (!(v >= -kMaxFloatStateMagnitude && v <= kMaxFloatStateMagnitude))
+        throw StateError(offset, std::string("a finite ") + what + " within +-2^48");
+    }
+  }
+}
 }  // namespace
 
 template <class S>
@@ -138,6 +158,7 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   head.expect<uint32_t>(0, "reserved 0");
 
   Cursor particles = reader.next(Section::Particles, int64_t(6 * n * sizeof(S)));  // read last
+  checkFloatValues<S>(particles, 6 * n, "particle position or velocity");
 
   Cursor bodySection = reader.next(Section::Bodies, int64_t(bodyCount * (13 * sizeof(S) + kBodyExtraBytes)));
   struct BodyRecord {
@@ -149,8 +170,16 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   std::vector<BodyRecord> records(bodyCount);
   for (BodyRecord& r : records) {
     r.at = bodySection.offset();
+    checkFloatValues<S>(bodySection, 13, "body pose or velocity");
     bodySection.readArray(r.v, 13, "a body's pose and velocities");
+    const uint64_t stillAt = bodySection.offset();
     r.stillTicks = bodySection.read<int32_t>("a body's still-tick count");
+    // A running world counts an awake body's still ticks up to ticksToSleep, where it falls asleep
+    // and the count stops; anything else was never saved (and INT32_MAX would overflow the count).
+    const int32_t maxStill = std::max<int32_t>(ticksToSleep_, 1);
+    if (r.stillTicks < 0 || r.stillTicks > maxStill)
+      throw StateError(stillAt, "a still-tick count from 0 to " + std::to_string(maxStill) + ", got " +
+                                    std::to_string(r.stillTicks));
     const uint64_t flagsAt = bodySection.offset();
     r.flags = bodySection.read<uint8_t>("a body's flags");
     if (r.flags & ~(kBodyAsleep | kBodyBladeOff)) throw StateError(flagsAt, "body flags 0 to 3");
@@ -206,6 +235,7 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
     c.featureA = impulseSection.read<uint32_t>("a contact feature");
     c.featureB = impulseSection.read<uint32_t>("a contact feature");
     S v[6];
+    checkFloatValues<S>(impulseSection, 6, "contact impulse or point");
     impulseSection.readArray(v, 6, "contact impulses and point");
     c.normal = v[0];
     c.tangent1 = v[1];
@@ -260,7 +290,7 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
     b.orientation = Quat<S>(r.v[3], r.v[4], r.v[5], r.v[6]);
     b.velocity = Vec3<S>(r.v[7], r.v[8], r.v[9]);
     b.angularVelocity = Vec3<S>(r.v[10], r.v[11], r.v[12]);
-    b.stillTicks = r.stillTicks < 0 ? 0 : r.stillTicks;
+    b.stillTicks = r.stillTicks;
     b.asleep = (r.flags & kBodyAsleep) != 0;
     b.bladeOn = (r.flags & kBodyBladeOff) == 0;
     b.updateDerived();

@@ -1,17 +1,54 @@
 #include "sim/terrain/heightmap.h"
 
-#include <stb_image.h>
+#include <spng.h>
 
 #include <cstring>
+#include <memory>
 
 namespace {
-std::string reason() {
-  const char* r = stbi_failure_reason();
-  return r && *r ? r : "corrupt or truncated";
+
+/// The largest ancillary chunk kept and the most bytes all kept chunks (text, ICC profiles, ...,
+/// after decompression) may take: a heightmap needs none of them, so these only stop a small file
+/// from asking spng for a large allocation (a zTXt decompression bomb). Chunks over the limits are
+/// an error, not skipped: a heightmap with a 1 MiB comment is not a file someone meant to feed us.
+constexpr size_t kMaxChunkBytes = size_t(1) << 20;
+constexpr size_t kMaxChunkCacheBytes = size_t(4) << 20;
+/// Heightmap sides (samples); scenario_json.cpp may cap the total further.
+constexpr uint32_t kMinSide = 2, kMaxSide = 16384;
+
+struct ContextFree {
+  void operator()(spng_ctx* ctx) const { spng_ctx_free(ctx); }
+};
+
+std::string readable(int err) {
+  // spng's own words but for the one that hides the Adler-32 check.
+  if (err == SPNG_EIDAT_STREAM) return "a readable PNG (damaged image data: a zlib error or a wrong Adler-32)";
+  const char* r = spng_strerror(err);
+  return std::string("a readable PNG (") + (r && *r ? r : "corrupt or truncated") + ")";
 }
+
+const char* colourTypeName(uint8_t type) {
+  switch (type) {
+    case SPNG_COLOR_TYPE_GRAYSCALE:
+      return "grayscale";
+    case SPNG_COLOR_TYPE_TRUECOLOR:
+      return "RGB";
+    case SPNG_COLOR_TYPE_INDEXED:
+      return "palette";
+    case SPNG_COLOR_TYPE_GRAYSCALE_ALPHA:
+      return "grayscale+alpha";
+    case SPNG_COLOR_TYPE_TRUECOLOR_ALPHA:
+      return "RGBA";
+    default:
+      return "unknown colour type";
+  }
+}
+
 }  // namespace
 
 namespace sg {
+// libspng (not stb_image): it checks every chunk's CRC and the zlib stream's Adler-32, so a
+// damaged heightmap is an error rather than a silently different terrain (docs/dependencies.md).
 bool decodeHeightmapPng(std::span<const uint8_t> bytes, Heightmap* out, std::string* error) {
   static const uint8_t kPngMagic[8] = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
   if (bytes.size() < 8 || std::memcmp(bytes.data(), kPngMagic, 8) != 0) {
@@ -22,34 +59,54 @@ bool decodeHeightmapPng(std::span<const uint8_t> bytes, Heightmap* out, std::str
     *error = "a PNG file smaller than 1 GiB";
     return false;
   }
-  const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
-  const int len = int(bytes.size());
-  int w = 0, h = 0, channels = 0;
-  if (!stbi_info_from_memory(data, len, &w, &h, &channels)) {
-    *error = "a readable PNG (" + reason() + ")";
+  const std::unique_ptr<spng_ctx, ContextFree> ctx(spng_ctx_new(0));
+  if (!ctx) {
+    *error = "a PNG decoder (out of memory)";
     return false;
   }
-  if (stbi_is_16_bit_from_memory(data, len)) {
-    *error = "an 8-bit grayscale PNG, got a 16-bit PNG";
+  // Checksums: spng's defaults are already "error" for both critical and ancillary chunk CRCs and
+  // for the Adler-32 (no SPNG_CTX_IGNORE_ADLER32); set explicitly so that a changed default cannot
+  // quietly turn them off.
+  int err = spng_set_crc_action(ctx.get(), SPNG_CRC_ERROR, SPNG_CRC_ERROR);
+  if (!err) err = spng_set_chunk_limits(ctx.get(), kMaxChunkBytes, kMaxChunkCacheBytes);
+  if (!err) err = spng_set_png_buffer(ctx.get(), bytes.data(), bytes.size());
+  spng_ihdr ihdr{};
+  if (!err) err = spng_get_ihdr(ctx.get(), &ihdr);
+  if (err) {
+    *error = readable(err);
     return false;
   }
-  if (channels != 1) {
-    *error = "an 8-bit grayscale PNG, got " + std::to_string(channels) + " channels";
+  if (ihdr.color_type != SPNG_COLOR_TYPE_GRAYSCALE || ihdr.bit_depth != 8) {
+    *error = "an 8-bit grayscale PNG, got a " + std::to_string(ihdr.bit_depth) + "-bit " +
+             colourTypeName(ihdr.color_type) + " PNG";
     return false;
   }
-  if (w < 2 || h < 2 || w > 16384 || h > 16384) {
-    *error = "a heightmap between 2x2 and 16384x16384 samples, got " + std::to_string(w) + "x" + std::to_string(h);
+  // The size is checked before anything is decoded: the decoded image is width*height bytes, so
+  // this bounds the one large allocation (256 MiB at 16384x16384). It is done here rather than
+  // with spng_set_image_limits, whose error would hide the declared size from the message.
+  if (ihdr.width < kMinSide || ihdr.height < kMinSide || ihdr.width > kMaxSide || ihdr.height > kMaxSide) {
+    *error = "a heightmap between 2x2 and 16384x16384 samples, got " + std::to_string(ihdr.width) + "x" +
+             std::to_string(ihdr.height);
     return false;
   }
-  stbi_uc* pixels = stbi_load_from_memory(data, len, &w, &h, &channels, 1);
-  if (!pixels) {
-    *error = "a readable PNG (" + reason() + ")";
+  size_t size = 0;
+  err = spng_decoded_image_size(ctx.get(), SPNG_FMT_PNG, &size);
+  if (!err && size != size_t(ihdr.width) * ihdr.height) err = SPNG_EOVERFLOW;
+  std::vector<uint8_t> samples;
+  if (!err) {
+    samples.resize(size);
+    // SPNG_FMT_PNG: the file's own 8-bit samples, no gamma, no tRNS, no conversion.
+    err = spng_decode_image(ctx.get(), samples.data(), samples.size(), SPNG_FMT_PNG, 0);
+  }
+  // The chunks after the image up to IEND: a file cut after its image data is truncated too.
+  if (!err) err = spng_decode_chunks(ctx.get());
+  if (err) {
+    *error = readable(err);
     return false;
   }
-  out->width = w;
-  out->height = h;
-  out->samples.assign(pixels, pixels + size_t(w) * size_t(h));
-  stbi_image_free(pixels);
+  out->width = int(ihdr.width);
+  out->height = int(ihdr.height);
+  out->samples = std::move(samples);
   return true;
 }
 }  // namespace sg

@@ -1,4 +1,4 @@
-// An 8-bit grayscale heightmap image, decoded from PNG bytes (stb_image). 0 = flat, 255 = the
+// An 8-bit grayscale heightmap image, decoded from PNG bytes (libspng). 0 = flat, 255 = the
 // scenario's maximum height. Decoding is pure: the caller reads the file.
 #pragma once
 

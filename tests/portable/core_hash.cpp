@@ -21,10 +21,8 @@
 #include "sim/world/tick_input.h"
 #include "sim/world/world.h"
 
-// The core reads PNG heightmaps with stb_image; the full build links the implementation from
-// the stb package, which a cross toolchain does not have: compile it here.
-#define STB_IMAGE_IMPLEMENTATION
-#include <stb_image.h>
+// The core reads PNG heightmaps with libspng: linked by .ci/i686-core-hashes (the host's, or the
+// static i686 build that .ci/cross-check makes).
 
 namespace {
 bool readBytes(const std::string& path, std::vector<uint8_t>* bytes) {

@@ -2,13 +2,41 @@
 
 #include <charconv>
 #include <cmath>
-#include <fstream>
+#include <map>
 #include <sstream>
+
+#include "replay/input_file.h"
 
 namespace sg::viewer {
 namespace {
 
-constexpr size_t kMaxVertices = 4'000'000;  // a mesh for looks; guards against runaway files
+// A mesh is drawn for looks: these bound what a file (at most InputLimits::kMeshBytes) can make
+// the viewer allocate and draw. 4 M triangles is ~100 MiB of vertex data at the worst.
+constexpr size_t kMaxVertices = 4'000'000;   ///< `v` lines, and `vn` lines
+constexpr size_t kMaxTriangles = 4'000'000;  ///< after fan triangulation
+/// |coordinate| bound (metres, body-local): keeps every cross product and normal sum finite in
+/// float (edges <= 2e6, products <= 8e12, sums over 12 M corners <= 1e20).
+constexpr float kMaxCoordinate = 1e6f;
+/// Echoed words are cut to this many characters (a 64 MiB line must not become the error).
+constexpr size_t kMaxEcho = 60;
+
+/// `w` quoted for an error: control characters escaped, cut to kMaxEcho characters.
+std::string quoted(std::string_view w) {
+  static const char kHex[] = "0123456789abcdef";
+  std::string q = "'";
+  for (size_t i = 0; i < w.size() && i < kMaxEcho; ++i) {
+    const auto c = static_cast<unsigned char>(w[i]);
+    if (c < 0x20 || c == 0x7f) {
+      q += "\\x";
+      q += kHex[c >> 4];
+      q += kHex[c & 15];
+    } else {
+      q += char(c);
+    }
+  }
+  if (w.size() > kMaxEcho) q += "...";
+  return q + "'";
+}
 
 /// Splits a line on spaces and tabs.
 std::vector<std::string_view> words(std::string_view line) {
@@ -23,9 +51,11 @@ std::vector<std::string_view> words(std::string_view line) {
   return w;
 }
 
+/// The whole word as a number: no trailing characters, no out-of-range value rounded to inf or 0
+/// (from_chars reports those), no NaN or infinity, and within kMaxCoordinate.
 bool parseFloat(std::string_view s, float* out) {
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), *out);
-  return ec == std::errc() && end == s.data() + s.size() && std::isfinite(*out);
+  return ec == std::errc() && end == s.data() + s.size() && std::isfinite(*out) && std::fabs(*out) <= kMaxCoordinate;
 }
 
 /// An OBJ index (1-based, or negative: relative to the end) to 0-based, or -1 when out of range.
@@ -66,7 +96,7 @@ bool parseObjMesh(const std::string& text, const std::string& name, ObjMesh* out
       float xyz[3];
       for (int a = 0; a < 3; ++a)
         if (!parseFloat(w[size_t(a) + 1], &xyz[a]))
-          return fail("a finite number, got '" + std::string(w[size_t(a) + 1]) + "'");
+          return fail("a finite number within +-1e6, got " + quoted(w[size_t(a) + 1]));
       auto& dst = w[0] == "v" ? v : vn;
       if (dst.size() / 3 >= kMaxVertices) return fail("at most " + std::to_string(kMaxVertices) + " vertices");
       dst.insert(dst.end(), xyz, xyz + 3);
@@ -74,6 +104,9 @@ bool parseObjMesh(const std::string& text, const std::string& name, ObjMesh* out
       ++vtCount;
     } else if (w[0] == "f") {
       if (w.size() < 4) return fail("a face of at least 3 vertices");
+      // Checked before the corners are read: a face of n corners is n - 2 triangles.
+      if (w.size() - 3 > kMaxTriangles - corners.size() / 3)
+        return fail("at most " + std::to_string(kMaxTriangles) + " triangles in the mesh");
       std::vector<Corner> face;
       for (size_t k = 1; k < w.size(); ++k) {
         // v, v/vt, v//vn or v/vt/vn.
@@ -83,17 +116,17 @@ bool parseObjMesh(const std::string& text, const std::string& name, ObjMesh* out
         corner.v = resolveIndex(c.substr(0, s1), v.size() / 3);
         if (corner.v < 0)
           return fail("a vertex index in 1.." + std::to_string(v.size() / 3) + " (or -1..-" +
-                      std::to_string(v.size() / 3) + "), got '" + std::string(c) + "'");
+                      std::to_string(v.size() / 3) + "), got " + quoted(c));
         if (s1 != std::string_view::npos) {
           const std::string_view rest = c.substr(s1 + 1);
           const size_t s2 = rest.find('/');
           const std::string_view vt = rest.substr(0, s2);
           if (!vt.empty() && resolveIndex(vt, vtCount) < 0)
-            return fail("a texture index in 1.." + std::to_string(vtCount) + ", got '" + std::string(c) + "'");
+            return fail("a texture index in 1.." + std::to_string(vtCount) + ", got " + quoted(c));
           if (s2 != std::string_view::npos) {
             corner.vn = resolveIndex(rest.substr(s2 + 1), vn.size() / 3);
             if (corner.vn < 0)
-              return fail("a normal index in 1.." + std::to_string(vn.size() / 3) + ", got '" + std::string(c) + "'");
+              return fail("a normal index in 1.." + std::to_string(vn.size() / 3) + ", got " + quoted(c));
           }
         }
         face.push_back(corner);
@@ -126,22 +159,19 @@ bool parseObjMesh(const std::string& text, const std::string& name, ObjMesh* out
   out->normals.clear();
   out->indices.clear();
   out->objVertices = v.size() / 3;
-  std::vector<std::vector<std::pair<int64_t, uint32_t>>> seen(v.size() / 3);
+  // A map, not a list per position: one position with many normals must not be quadratic.
+  std::map<std::pair<int64_t, int64_t>, uint32_t> seen;
   for (const Corner& c : corners) {
-    auto& list = seen[size_t(c.v)];
-    uint32_t index = 0;
-    bool found = false;
-    for (const auto& [normal, i] : list)
-      if (normal == c.vn) index = i, found = true;
-    if (!found) {
-      index = uint32_t(out->positions.size() / 3);
-      list.push_back({c.vn, index});
+    const auto [at, added] = seen.try_emplace({c.v, c.vn}, uint32_t(out->positions.size() / 3));
+    const uint32_t index = at->second;
+    if (added) {
       const float* p = &v[size_t(c.v) * 3];
       const float* n = c.vn >= 0 ? &vn[size_t(c.vn) * 3] : &accumulated[size_t(c.v) * 3];
-      float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      // In double: the squares of a 1e20 sum overflow float.
+      const double len = std::sqrt(double(n[0]) * n[0] + double(n[1]) * n[1] + double(n[2]) * n[2]);
       out->positions.insert(out->positions.end(), p, p + 3);
-      if (len > 1e-20f)
-        out->normals.insert(out->normals.end(), {n[0] / len, n[1] / len, n[2] / len});
+      if (len > 1e-20)
+        out->normals.insert(out->normals.end(), {float(n[0] / len), float(n[1] / len), float(n[2] / len)});
       else
         out->normals.insert(out->normals.end(), {0.0f, 1.0f, 0.0f});  // degenerate: any unit normal
     }
@@ -151,14 +181,12 @@ bool parseObjMesh(const std::string& text, const std::string& name, ObjMesh* out
 }
 
 bool loadObjMesh(const std::string& path, ObjMesh* out, std::string* error) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) {
-    *error = path + ":0: expected a readable OBJ file (cannot open it)";
+  std::string text, expected;
+  if (!readInputFile(path, InputLimits::kMeshBytes, &text, &expected)) {
+    *error = path + ":0: expected " + expected;
     return false;
   }
-  std::ostringstream text;
-  text << file.rdbuf();
-  return parseObjMesh(text.str(), path, out, error);
+  return parseObjMesh(text, path, out, error);
 }
 
 }  // namespace sg::viewer

@@ -8,7 +8,7 @@ come from the system's libxxhash through ctypes, the library the reader itself u
     python3 tests/data/sgr/make_damaged.py --record build/release/replay/simgrass
 
 --record SIMGRASS first re-records tiny.sgr from tiny.json (24 ticks, a hash every tick, a
-snapshot every 8) and the fuzz seeds in tests/fuzz/corpus/ with that executable; without it the
+snapshot every 8) and the fuzz seeds in tests/fuzz/corpus/sgr_reader/ with that executable; without it the
 corpus is rebuilt from the committed tiny.sgr (the output is then byte-for-byte the same):
 
     python3 tests/data/sgr/make_damaged.py
@@ -39,7 +39,7 @@ import tempfile
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", "..", ".."))
 DAMAGED = os.path.join(HERE, "damaged")
-SEEDS = os.path.join(REPO, "tests", "fuzz", "corpus")
+SEEDS = os.path.join(REPO, "tests", "fuzz", "corpus", "sgr_reader")
 
 MAGIC = b"\x89SGR\r\n\x1a\n"
 VERSION = 1
