@@ -27,7 +27,6 @@ struct InputLimits {
   static constexpr uint64_t kMeshBytes = uint64_t(64) << 20;        ///< OBJ mesh
   static constexpr uint64_t kScriptBytes = uint64_t(4) << 20;       ///< viewer script
   static constexpr uint64_t kRecordingBytes = uint64_t(16) << 30;   ///< .sgr recording
-  static constexpr uint64_t kStateBytes = uint64_t(4) << 30;        ///< saved state
 };
 
 /// An open, regular, bounded input file. Move-only; closes on destruction.

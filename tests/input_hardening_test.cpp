@@ -338,6 +338,18 @@ TEST(ScenarioOrientation, NonUnitAndZeroQuaternionsAreRejected) {
   EXPECT_NO_THROW(parse(body("[1, 0, 0, 0]")));
 }
 
+TEST(ScenarioDerived, AValueWhoseDerivedConstantOverflowsIsNamedAsSuch) {
+  // 1e-30 itself is a fine spacing or mass to write; what does not fit is 1/spacing or 1/mass.
+  // The message must say so, not call the written value 1e30.
+  auto build = [](const char* text) { return [text] { makeWorld(parse(text)); }; };
+  EXPECT_TRUE(throwsError(build(R"({"field": {"spacing": "1e-30"}})"), "$.field.spacing",
+                          "whose 1/(spacing x interpolation) is within the fx32 range"));
+  EXPECT_TRUE(throwsError(build(R"({"particles": {"mass": "1e-35"}})"), "$.particles.mass",
+                          "whose 1/mass is within the fx32 range"));
+  EXPECT_TRUE(throwsError(build(R"({"particles": {"mass": 6e8}})"), "$.particles.mass",
+                          "expected a value within the fx32 range"));
+}
+
 // ---- 7. heightmap size cap and memory estimate ------------------------------------------------
 
 TEST(ScenarioHeightmap, SideAbove4096IsRejected) {

@@ -5,6 +5,7 @@
 
 #include "sim/bodies/rigid_body.h"
 #include "sim/scenario/derived.h"
+#include "sim/scenario/json_bounds.h"
 
 namespace sg {
 namespace {
@@ -113,7 +114,7 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
     std::ostringstream o;
     o.precision(3);
     const bool heightmap = !s.terrain.flat;
-    o << "a " << (heightmap ? "field and heightmap" : "field") << " that fit in memory: " << s.field.patchesX << " x "
+    o << "a " << (heightmap ? "field and heightmap" : "field") << " that fits in memory: " << s.field.patchesX << " x "
       << s.field.patchesZ << " patches";
     if (heightmap) o << " and " << s.terrain.heightmap.width << " x " << s.terrain.heightmap.height << " samples";
     o << " need " << double(bytes) / (1 << 30) << " GiB, the limit is " << double(memoryLimitBytes) / (1 << 30)
@@ -159,12 +160,18 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
         check(std::fabs(d(s.wind.schedule[i].force[c])),
               ("$.wind.schedule[" + std::to_string(i) + "].force[" + std::to_string(c) + "]").c_str(), "a force");
     // Every other number the world converts must fit too (velocities, accelerations, ...).
-    auto fits = [&](const Rational& r, const std::string& path) {
-      if (!ScalarTraits<S>::fromRational(r) || !(std::fabs(r.toDouble()) <= limit))
-        throw ScenarioError(s.sourceName, path,
-                            "a value within the " + std::string(scalarName(ScalarTraits<S>::kind)) +
-                                " range (|value| <= " + metres(limit).substr(0, metres(limit).size() - 2) + "), got " +
-                                r.toString());
+    // `derivedName`: the value checked is a constant the world derives from the one at `path`
+    // (1/mass, 1/dt, ...); the message says so instead of calling 1e30 the value written.
+    auto fits = [&](const Rational& r, const std::string& path, const char* derivedName = nullptr) {
+      if (!ScalarTraits<S>::fromRational(r) || !(std::fabs(r.toDouble()) <= limit)) {
+        const std::string range = std::string(scalarName(ScalarTraits<S>::kind)) +
+                                  " range (|value| <= " + metres(limit).substr(0, metres(limit).size() - 2) + ")";
+        if (derivedName)
+          throw ScenarioError(s.sourceName, path,
+                              "a value whose " + std::string(derivedName) + " is within the " + range + ", got " +
+                                  derivedName + " = " + echoText(r.toString()));
+        throw ScenarioError(s.sourceName, path, "a value within the " + range + ", got " + echoText(r.toString()));
+      }
     };
     const auto& pa = s.particles;
     for (int c = 0; c < 3; ++c) {
@@ -175,12 +182,12 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
     }
     fits(pa.constraintLength, "$.particles.constraintLength");
     fits(pa.mass, "$.particles.mass");
-    fits(derived.invMass, "$.particles.mass");
-    fits(derived.invDt, "$.timeStep");
-    fits(derived.halfRod, "$.particles.constraintLength");
-    fits(derived.jitterAmplitude, "$.field.jitter");
-    fits(derived.fieldOriginX, "$.field.center[0]");
-    fits(derived.fieldOriginZ, "$.field.center[1]");
+    fits(derived.invMass, "$.particles.mass", "1/mass");
+    fits(derived.invDt, "$.timeStep", "1/timeStep");
+    fits(derived.halfRod, "$.particles.constraintLength", "constraintLength/2");
+    fits(derived.jitterAmplitude, "$.field.jitter", "jitter x spacing");
+    fits(derived.fieldOriginX, "$.field.center[0]", "field corner x");
+    fits(derived.fieldOriginZ, "$.field.center[1]", "field corner z");
     fits(s.field.scaleY, "$.field.scaleY");
     fits(s.field.scaleXZ, "$.field.scaleXZ");
     fits(s.field.spacing, "$.field.spacing");
@@ -189,12 +196,12 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
     for (size_t i = 0; i < derived.gustForcePerMass.size(); ++i)
       for (int c = 0; c < 3; ++c)
         fits(derived.gustForcePerMass[i][size_t(c)],
-             "$.wind.schedule[" + std::to_string(i) + "].force[" + std::to_string(c) + "]");
+             "$.wind.schedule[" + std::to_string(i) + "].force[" + std::to_string(c) + "]", "force/mass");
     if (!s.terrain.flat) {
       fits(s.terrain.cellSize, "$.terrain.cellSize");
-      fits(derived.terrainInvCellSize, "$.terrain.cellSize");
-      fits(derived.terrainOriginX, "$.terrain.center[0]");
-      fits(derived.terrainOriginZ, "$.terrain.center[1]");
+      fits(derived.terrainInvCellSize, "$.terrain.cellSize", "1/cellSize");
+      fits(derived.terrainOriginX, "$.terrain.center[0]", "heightmap corner x");
+      fits(derived.terrainOriginZ, "$.terrain.center[1]", "heightmap corner z");
       fits(s.terrain.maxHeight, "$.terrain.maxHeight");
     }
     // Bodies: every value fits, positions within the coordinate range, mass properties exact.
@@ -265,8 +272,8 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
     // Everything else the world converts (world.cpp toS): no value may reach a throwing conversion.
     fits(s.bodies.mowerCutHeight, "$.bodies.mowerCutHeight");
     fits(s.bodies.grassDrag, "$.bodies.grassDrag");
-    fits(derived.invParticleSpacing, "$.field.spacing");
-    fits(derived.dampingPerTick, "$.particles.damping");
+    fits(derived.invParticleSpacing, "$.field.spacing", "1/(spacing x interpolation)");
+    fits(derived.dampingPerTick, "$.particles.damping", "damping per tick");
     if (s.markings.enabled) {
       const auto& m = s.markings;
       check(std::fabs(d(m.centerX)), "$.markings.center[0]", "a markings centre");
