@@ -1,6 +1,9 @@
 // Writing an output file so that it is either complete or absent: the bytes go to a temporary
 // file in the target's folder, every write and the close are checked, and only then is it renamed
-// over the target (rename within a folder is atomic on POSIX file systems).
+// over the target (rename within a folder is atomic on POSIX file systems). A symbolic link is
+// followed (the link stays, the file it names is replaced); a character device (/dev/null,
+// /dev/full) or a FIFO is written straight to (a FIFO nobody reads is an error, not a wait); a
+// directory, socket or block device is refused.
 #pragma once
 
 #include <cstdint>

@@ -32,6 +32,19 @@ Scenario loadScenarioFile(const std::string& path, std::vector<sgr::EmbeddedFile
   return parseScenario(std::string(bytes.begin(), bytes.end()), path, readRelative);
 }
 
+std::vector<std::string> filesNamedBy(const Scenario& scenario, const std::vector<sgr::EmbeddedFile>& files,
+                                      const std::string& folder) {
+  std::vector<std::string> out;
+  auto add = [&](const std::string& name) {
+    if (name.empty()) return;
+    const std::filesystem::path p(name);
+    out.push_back(p.is_absolute() ? name : (std::filesystem::path(folder) / p).string());
+  };
+  for (const sgr::EmbeddedFile& f : files) add(f.name);
+  for (const BodySpec& b : scenario.bodies.list) add(b.mesh);
+  return out;
+}
+
 uint64_t physicalMemoryBytes() {
   const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
   return pages > 0 && size > 0 ? uint64_t(pages) * uint64_t(size) : 0;

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "replay/format/sgr_format.h"
 #include "sim/scenario/scenario.h"
@@ -13,6 +14,13 @@ namespace sg {
 /// Reads and parses a scenario file; an empty path gives the embedded thesis meadow. When
 /// `files` is given, it receives every file the scenario named (for embedding in recordings).
 Scenario loadScenarioFile(const std::string& path, std::vector<sgr::EmbeddedFile>* files = nullptr);
+
+/// Every file a scenario loaded from `scenarioFile` reads, as paths to open: the files it
+/// embedded (`files`, from loadScenarioFile: the heightmap) and the OBJ meshes its bodies name for
+/// looks, each resolved against `folder` (the scenario's folder; for a recording, the recording's).
+/// What no command may write over.
+std::vector<std::string> filesNamedBy(const Scenario& scenario, const std::vector<sgr::EmbeddedFile>& files,
+                                      const std::string& folder);
 
 /// Physical memory of this machine in bytes (the default memory budget for a world).
 uint64_t physicalMemoryBytes();

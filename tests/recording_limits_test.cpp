@@ -493,6 +493,66 @@ TEST(RecordingLimits, TheWriterRefusesAHeaderOrAnInputTheReaderWouldRefuse) {
   EXPECT_EQ(r.end->message.size(), sgr::kMaxShortString);
 }
 
+TEST(RecordingLimits, TheWriterRefusesTheChunkThatWouldPassTheReadersLimit) {
+  // The reader takes at most InputLimits::kRecordingBytes (16 GiB); a recording grown past it
+  // would be refused at byte 0. The limit is lowered here so the test writes kilobytes.
+  TempDir dir;
+  const std::string path = dir.file("capped.sgr");
+  uint64_t limit = 0;
+  {
+    sgr::Header h = tinyHeader();
+    h.checkEvery = 1;
+    h.snapshotEvery = 0;
+    sgr::Writer w(path, h);
+    limit = w.bytesWritten() + 4096;
+    w.maxBytes = limit;
+    bool refused = false;
+    for (int64_t t = 0; t < 1000 && !refused; ++t) {
+      try {
+        w.check({t + 1, uint64_t(t)});
+        w.flush();
+      } catch (const std::runtime_error& e) {
+        refused = true;
+        EXPECT_TRUE(contains(e.what(), "at most " + std::to_string(limit) + " bytes")) << e.what();
+      }
+    }
+    EXPECT_TRUE(refused) << "the writer went past its limit";
+  }
+  EXPECT_LE(fs::file_size(path), limit);
+  const sgr::Recording r = sgr::readRecording(path);  // readable: cut off before END
+  EXPECT_TRUE(r.truncated);
+  EXPECT_FALSE(r.checks.empty());
+}
+
+TEST(RecordingLimits, AReplayThatFaultedBeforeItsTargetWritesNoState) {
+  // No hashes and a command at tick 0 that makes the ball's velocity overflow: the replay faults
+  // in the first step, long before --to 7; the state it stopped in is not tick 7's.
+  sgr::Header h = tinyHeader();
+  h.checkEvery = 0;
+  h.snapshotEvery = 0;
+  std::vector<Chunk> chunks{{sgr::ChunkType::Head, sgr::encodeHead(h)}};
+  TickInput blast;
+  blast.bodies.push_back(
+      BodyCommand{0, BodyCommandKind::AddVelocity, InputVec3{int64_t(1) << 62, int64_t(1) << 62, int64_t(1) << 62}});
+  chunks.push_back({sgr::ChunkType::Input, sgr::encodeInput(0, blast, TickInput{})});
+  sgr::EndInfo e;
+  e.tick = 10;
+  chunks.push_back({sgr::ChunkType::End, sgr::encodeEnd(e)});
+  TempDir dir;
+  const std::string recording = dir.file("faults.sgr");
+  writeBytes(recording, assemble(chunks));
+  for (const char* how : {"", " --verify"}) {
+    for (const char* name : {"s.json", "s.bin"}) {
+      const std::string state = dir.file(name);
+      const CliResult r = runCli("replay " + quote(recording) + " --to 7" + how + " --export-state " + quote(state));
+      EXPECT_EQ(r.exitCode, kExitMismatch) << r.describe();
+      EXPECT_TRUE(isOneLine(r.err)) << r.describe();
+      EXPECT_TRUE(contains(r.err, "no state written to " + state)) << r.describe();
+      EXPECT_FALSE(fs::exists(state)) << "a state was written for a replay that faulted" << r.describe();
+    }
+  }
+}
+
 TEST(RecordingLimits, RecordRefusesAnInputLargerThanAnInptChunkBeforeWriting) {
   TempDir dir;
   nlohmann::json s = nlohmann::json::parse(readFile(tinyScenario()));

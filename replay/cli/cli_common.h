@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 #include "replay/input_file.h"
 
@@ -73,8 +74,8 @@ printError(const char* format, ...) {
 /// True, after one line on stderr, when the output file `output` (given with `option`, e.g.
 /// "--export-state") is one of the command's `inputs` (same device and inode: hard links and
 /// "./x" spellings included): the command refuses to overwrite its own input.
-inline bool overwritesInput(const char* command, const char* option, const std::string& output,
-                            std::initializer_list<std::string> inputs) {
+template <class Inputs>
+bool overwritesAnyOf(const char* command, const char* option, const std::string& output, const Inputs& inputs) {
   if (output.empty()) return false;
   for (const std::string& input : inputs) {
     if (input.empty() || !sameFile(input, output)) continue;
@@ -84,12 +85,27 @@ inline bool overwritesInput(const char* command, const char* option, const std::
   }
   return false;
 }
+inline bool overwritesInput(const char* command, const char* option, const std::string& output,
+                            std::initializer_list<std::string> inputs) {
+  return overwritesAnyOf(command, option, output, inputs);
+}
+/// The same for a list of inputs built at run time (a scenario's heightmap and meshes).
+inline bool overwritesInput(const char* command, const char* option, const std::string& output,
+                            const std::vector<std::string>& inputs) {
+  return overwritesAnyOf(command, option, output, inputs);
+}
 
 /// True, after one line on stderr, when two output options name the same file (one would
 /// silently replace the other).
 inline bool sameOutputTwice(const char* command, const char* optionA, const std::string& a, const char* optionB,
                             const std::string& b) {
-  if (a.empty() || b.empty() || !(a == b || sameFile(a, b))) return false;
+  // Spelled the same once made absolute and normalised ("./x", "d/../x"), or the same existing file.
+  auto normal = [](const std::string& p) {
+    std::error_code ec;
+    const std::filesystem::path abs = std::filesystem::absolute(p, ec);
+    return ec ? std::filesystem::path(p).lexically_normal() : abs.lexically_normal();
+  };
+  if (a.empty() || b.empty() || !(a == b || normal(a) == normal(b) || sameFile(a, b))) return false;
   printError("simgrass %s: %s %s: expected a file other than the %s output", command, optionB, b.c_str(), optionA);
   return true;
 }

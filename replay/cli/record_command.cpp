@@ -72,12 +72,9 @@ int record(const RecordOptions& o) {
   settings.snapshotEvery = uint32_t(o.snapshotEvery);
   settings.zstdLevel = o.zstdLevel;
   // Everything `simgrass replay` would refuse is refused here, before the file is touched.
-  const std::filesystem::path scenarioDir = std::filesystem::path(o.scenario).parent_path();
-  for (const sgr::EmbeddedFile& f : files) {
-    const std::filesystem::path p =
-        std::filesystem::path(f.name).is_absolute() ? std::filesystem::path(f.name) : scenarioDir / f.name;
-    if (overwritesInput("record", "-o", o.output, {p.string()})) return kExitBadInput;
-  }
+  // Nor a file the scenario reads: its heightmap, the OBJ meshes its bodies name for looks.
+  const std::string scenarioDir = std::filesystem::path(o.scenario).parent_path().string();
+  if (overwritesInput("record", "-o", o.output, filesNamedBy(scenario, files, scenarioDir))) return kExitBadInput;
   {
     const uint32_t interval = settings.checkEvery == 0      ? settings.snapshotEvery
                               : settings.snapshotEvery == 0 ? settings.checkEvery

@@ -94,6 +94,11 @@ int replay(const ReplayOptions& o) {
   // Verifying a recording that stopped on a fault replays the faulting step too: the world is left
   // in that step's state, which no recorded hash describes.
   bool inFaultedStep = false;
+  // A replay that faulted never reached the tick asked for: no state file is written for it (the
+  // state it stopped in is not the one --export-state promises).
+  bool faulted = false;
+  const std::string noStateWritten =
+      o.exportState.empty() ? std::string() : "; no state written to " + echoed(o.exportState);
   const auto start = std::chrono::steady_clock::now();
   try {
     if (o.verify) {
@@ -106,9 +111,10 @@ int replay(const ReplayOptions& o) {
       if (!v.ok) {
         out["firstMismatchTick"] = v.firstMismatchTick;
         if (v.fault) {
+          faulted = true;
           out["error"] = v.fault->message();
-          printError("simgrass replay: %s: the replay faulted where the recording did not: %s\n", o.file.c_str(),
-                     v.fault->message().c_str());
+          printError("simgrass replay: %s: the replay faulted where the recording did not: %s%s\n", o.file.c_str(),
+                     v.fault->message().c_str(), noStateWritten.c_str());
         } else {
           out["expectedHash"] = hex(v.expectedHash);
           out["actualHash"] = hex(v.actualHash);
@@ -131,7 +137,8 @@ int replay(const ReplayOptions& o) {
       const StepResult r = player->seek(target, [&bar](int64_t done) { bar.update(done); });
       bar.finish();
       if (!r.ok) {
-        printError("simgrass replay: %s\n", r.error.message().c_str());
+        faulted = true;
+        printError("simgrass replay: %s%s\n", r.error.message().c_str(), noStateWritten.c_str());
         out["error"] = r.error.message();
         code = kExitMismatch;
       }
@@ -155,7 +162,13 @@ int replay(const ReplayOptions& o) {
                hex(hash).c_str(), hex(*expected).c_str());
     code = kExitMismatch;
   }
-  if (!o.exportState.empty()) {
+  if (!o.exportState.empty() && !faulted && o.to >= 0 && tick != o.to) {
+    // A --verify that stopped on a hash mismatch before --to: the state is not the one asked for.
+    printError("simgrass replay: %s: stopped at tick %" PRId64 ", not at --to %" PRId64 "%s\n", o.file.c_str(), tick,
+               o.to, noStateWritten.c_str());
+    faulted = true;
+  }
+  if (!o.exportState.empty() && !faulted) {
     // .json: the documented plain-number form; anything else: the binary state (SGSTATE2).
     const bool asJson = std::filesystem::path(o.exportState).extension() == ".json";
     std::string error;
@@ -180,7 +193,7 @@ int replay(const ReplayOptions& o) {
                 inFaultedStep ? " (in the step that faulted, as recorded)"
                 : expected    ? (*expected == hash ? " (matches the recording)" : " (DIFFERS from the recording)")
                               : "");
-    if (!o.exportState.empty()) std::printf("state written to %s\n", o.exportState.c_str());
+    if (!o.exportState.empty() && !faulted) std::printf("state written to %s\n", o.exportState.c_str());
   }
   if (code == kExitOk && rec->truncated) code = kExitTruncated;
   return code;

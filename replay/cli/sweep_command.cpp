@@ -433,11 +433,16 @@ int sweep(const SweepOptions& o) {
     scenarios.push_back(std::move(sc));
   }
   if (!prepareOutputFolder(o.out)) return kExitBadInput;
-  // No output may replace one of the scenarios it is computed from.
+  // No output may replace one of the scenarios it is computed from, nor a file one of them reads
+  // (a heightmap, a mesh: `--out o3` once wrote the plot o3/h-body.png over scenario h's heightmap).
+  std::vector<std::string> inputs;
+  for (const SweepScenario& sc : scenarios) {
+    inputs.push_back(sc.file);
+    for (const std::string& f : filesNamedBy(sc.reference, sc.files, fs::path(sc.file).parent_path().string()))
+      inputs.push_back(f);
+  }
   auto overwritesScenario = [&](const std::string& output) {
-    for (const SweepScenario& sc : scenarios)
-      if (overwritesInput("sweep", "--out", output, {sc.file})) return true;
-    return false;
+    return overwritesInput("sweep", "--out", output, inputs);
   };
   for (const char* name : {"sweep.csv", "sweep.json"})
     if (overwritesScenario((fs::path(o.out) / name).string())) return kExitBadInput;

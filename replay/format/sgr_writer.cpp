@@ -159,7 +159,7 @@ std::vector<uint8_t> frameChunk(ChunkType type, std::span<const uint8_t> payload
   return out;
 }
 
-Writer::Writer(const std::string& path, const Header& header) : path_(path) {
+Writer::Writer(const std::string& path, const Header& header) : maxBytes(InputLimits::kRecordingBytes), path_(path) {
   // Checked before the file is created: a recording the reader would refuse is never started.
   if (const std::string why = headerProblem(header); !why.empty())
     throw std::runtime_error(path + ": cannot record: expected " + why);
@@ -203,6 +203,10 @@ void Writer::append(ChunkType type, std::span<const uint8_t> payload) {
   if (fd_ < 0) throw std::runtime_error(path_ + ": the recording is already closed");
   if (failed_) throw std::runtime_error(path_ + ": the recording stopped at an earlier write error");
   const std::vector<uint8_t> chunk = frameChunk(type, payload);
+  if (written_ + pending_.size() + chunk.size() > maxBytes)
+    throw std::runtime_error(path_ + ": cannot record further: expected a recording of at most " +
+                             std::to_string(maxBytes) + " bytes (what a reader accepts); it stops at " +
+                             std::to_string(written_ + pending_.size()) + " bytes, readable up to there");
   pending_.insert(pending_.end(), chunk.begin(), chunk.end());
 }
 

@@ -52,6 +52,10 @@ class Writer {
   uint64_t bytesWritten() const { return written_; }
   const std::string& path() const { return path_; }
   int zstdLevel = 3;
+  /// The largest file this writer produces: the reader's limit (InputLimits::kRecordingBytes), so
+  /// that no recording grows into one that replay refuses at byte 0. A chunk that would cross it
+  /// is refused (std::runtime_error); the file so far stays readable. Lowered by the tests.
+  uint64_t maxBytes;
 
  private:
   void append(ChunkType type, std::span<const uint8_t> payload);

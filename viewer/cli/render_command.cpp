@@ -317,6 +317,7 @@ int render(const RenderOptions& o) {
   std::unique_ptr<SimWorld> ownWorld;
   std::unique_ptr<sgr::Recording> recording;
   std::unique_ptr<Player> player;
+  std::vector<sgr::EmbeddedFile> scenarioFiles;  // what a scenario input read beside itself (heightmap)
   try {
     if (sgr::hasRecordingMagic(o.input)) {
       recording = std::make_unique<sgr::Recording>(sgr::readRecording(o.input));
@@ -326,7 +327,7 @@ int render(const RenderOptions& o) {
         return fail(kExitBadInput, "--ticks: the recording " + o.input + " ends at tick " +
                                        std::to_string(recording->lastTick()) + ", got " + o.ticks);
     } else {
-      scenario = loadScenarioFile(o.input);
+      scenario = loadScenarioFile(o.input, &scenarioFiles);
       ownWorld = makeWorld(scenario, o.threads, physicalMemoryBytes());
     }
   } catch (const sgr::RecordingError& e) {
@@ -336,6 +337,48 @@ int render(const RenderOptions& o) {
   }
   SimWorld& world = player ? player->world() : *ownWorld;
   auto inputAt = [&](int64_t tick) { return recording ? recording->inputAt(tick) : scriptedInput(scenario, tick); };
+
+  // ---- outputs against inputs and each other, before anything is written ----
+  // Inputs: the scenario or recording, the heightmap a scenario read, the meshes its bodies name
+  // (relative to the input's folder; a recording's heightmap is inside it). `-o r5` once wrote
+  // frame-000003.png over the scenario's heightmap r5/frame-000003.png.
+  const std::string inputFolder = fs::path(o.input).parent_path().string();
+  std::vector<std::string> inputs = filesNamedBy(scenario, scenarioFiles, inputFolder);
+  inputs.push_back(o.input);
+  auto isRenderedFrame = [&](const fs::path& file) {  // one of this run's frame-TTTTTT.png in -o
+    const std::string name = file.filename().string();
+    if (name.size() < 16 || name.rfind("frame-", 0) != 0 || name.substr(name.size() - 4) != ".png") return false;
+    const std::string digits = name.substr(6, name.size() - 10);
+    if (digits.size() > 18 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      return false;
+    const int64_t tick = std::stoll(digits);
+    char canonical[32];
+    std::snprintf(canonical, sizeof canonical, "frame-%06" PRId64 ".png", tick);
+    if (name != canonical || tick < range->first || tick > range->last || (tick - range->first) % range->step != 0)
+      return false;
+    auto folderOf = [](const fs::path& p) {  // symbolic links resolved, "." and ".." gone, no trailing '/'
+      std::error_code ec;
+      fs::path f = fs::weakly_canonical(fs::absolute(p, ec), ec);
+      if (ec) f = fs::absolute(p, ec).lexically_normal();
+      return f.has_filename() ? f : f.parent_path();
+    };
+    return folderOf(file.parent_path()) == folderOf(o.output);
+  };
+  {
+    std::error_code listed;
+    for (const fs::directory_entry& entry : fs::directory_iterator(o.output, listed)) {
+      if (!isRenderedFrame(entry.path())) continue;
+      if (overwritesInput("render", "-o", entry.path().string(), inputs)) return kExitBadInput;
+    }
+  }
+  for (const auto& [option, file] : {std::pair<const char*, const std::string*>{"--contact-sheet", &o.contactSheet},
+                                     std::pair<const char*, const std::string*>{"--video", &o.video}}) {
+    if (file->empty()) continue;
+    if (overwritesInput("render", option, *file, inputs)) return kExitBadInput;
+    if (isRenderedFrame(*file))
+      return fail(kExitBadInput, std::string(option) + " " + *file + ": expected a file other than a frame of -o");
+  }
+  if (sameOutputTwice("render", "--contact-sheet", o.contactSheet, "--video", o.video)) return kExitBadInput;
 
   std::error_code ec;
   fs::create_directories(o.output, ec);
@@ -360,7 +403,6 @@ int render(const RenderOptions& o) {
   std::vector<double> simMsPerTick, extractMs, renderMs, writeMs;
   std::vector<viewer::Image> thumbs;
   std::vector<std::string> files;
-  std::string assetNote;  // the first mesh that failed to load
   const int thumbW = std::min(width, 320), thumbH = std::max(1, height * thumbW / width);
   using Clock = std::chrono::steady_clock;
   auto ms = [](Clock::time_point a, Clock::time_point b) {
@@ -399,16 +441,15 @@ int render(const RenderOptions& o) {
       double frameMs = 0;
       const viewer::Image image = renderer->render(scene, camera, &frameMs);
       renderMs.push_back(frameMs);
-      if (!renderer->renderer().lastAssetError().empty() && assetNote.empty()) {
-        assetNote = renderer->renderer().lastAssetError();
-        std::fprintf(stderr, "simgrass render: note: %s (drawing the body's primitives)\n", assetNote.c_str());
-      }
+      // A mesh that does not load is bad input: the frames would silently show the wrong looks
+      // (the interactive viewer draws the primitives and says so in its window instead).
+      if (!renderer->renderer().lastAssetError().empty())
+        return fail(kExitBadInput, renderer->renderer().lastAssetError());
 
       char name[32];
       std::snprintf(name, sizeof name, "frame-%06" PRId64 ".png", tick);
       const std::string file = (fs::path(o.output) / name).string();
-      if (sameFile(file, o.input))
-        return fail(kExitBadInput, file + ": expected an output file other than the input " + o.input);
+      if (overwritesInput("render", "-o", file, inputs)) return kExitBadInput;
       const auto t3 = Clock::now();
       if (!viewer::writePng(file, image, &error)) return fail(kExitBadInput, error);
       writeMs.push_back(ms(t3, Clock::now()));
@@ -463,7 +504,6 @@ int render(const RenderOptions& o) {
     j["ssao"] = o.ssao;
     j["rockBlend"] = !o.noRock;
     j["debug"] = o.debug;
-    if (!assetNote.empty()) j["assetError"] = assetNote;
     j["renderer"] = gl;
     j["tufts"] = renderer->scene().tufts.size();
     j["medianSimulationMsPerTick"] = median(simMsPerTick);
