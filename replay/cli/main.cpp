@@ -18,6 +18,7 @@
 #include "replay/cli/run_command.h"
 #include "replay/cli/sweep_command.h"
 #include "replay/kernel_environment.h"
+#include "sim/world/chunk_pool.h"
 
 namespace {
 /// The subcommand being run ("replay"), or "" before one was parsed.
@@ -57,6 +58,11 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     // One line, non-zero: the command-line counterpart of a bad scenario.
     sg::printError("simgrass: %s (see 'simgrass --help')", e.what());
+    return 2;
+  } catch (const sg::ThreadStartError& e) {
+    // --threads larger than the machine lets this process start (ulimit -u, address space).
+    const std::string cmd = commandName(app);
+    sg::printError("simgrass%s%s: %s", cmd.empty() ? "" : " ", cmd.c_str(), e.what());
     return 2;
   } catch (const std::bad_alloc&) {
     // Last resort: every input is bounded before it is allocated for, so this is a bug (or a

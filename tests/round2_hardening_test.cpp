@@ -1,0 +1,94 @@
+// Promises of docs/robustness.md that an independent tester broke (issue 14, round 2):
+//  - a --threads the machine cannot start is one line and exit 2, never a hang in the pool;
+//  - integer options are decimal (no octal "010", no hex "0x10");
+//  - ...
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <string>
+
+#include "sim/world/chunk_pool.h"
+#include "tests/cli_support.h"
+#include "tests/test_support.h"
+
+#if defined(__SANITIZE_ADDRESS__)
+#define SIMGRASS_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define SIMGRASS_TEST_ASAN 1
+#endif
+#endif
+
+namespace sg {
+namespace {
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+std::string tinyScenario() { return test::sourcePath("tests/data/sgr/tiny.json"); }
+
+// --- threads the machine will not start ---------------------------------------------------
+
+// In a forked child with an address-space limit too small for 256 thread stacks, the pool
+// throws ThreadStartError after joining what it started; before the fix the child hung in
+// pthread_cond_destroy (the alarm turns a hang into SIGALRM, a failure).
+TEST(ThreadStartLimits, ChunkPoolThatCannotStartItsThreadsThrowsAndJoins) {
+#ifdef SIMGRASS_TEST_ASAN
+  GTEST_SKIP() << "an address-space limit and AddressSanitizer's shadow memory do not mix";
+#else
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    alarm(30);
+    rlimit limit{};
+    limit.rlim_cur = limit.rlim_max = rlim_t(1) << 30;  // 1 GiB: far less than 256 x 8 MiB stacks
+    if (setrlimit(RLIMIT_AS, &limit) != 0) _exit(10);
+    try {
+      ChunkPool pool(256);
+      _exit(11);  // started them all: the limit did not bite
+    } catch (const ThreadStartError& e) {
+      const std::string what = e.what();
+      _exit(e.requested() == 256 && e.created() >= 1 && e.created() < 256 &&
+                    contains(what, "--threads: expected a thread count this machine can start (created ") &&
+                    contains(what, " of 256)")
+                ? 0
+                : 12);
+    } catch (...) {
+      _exit(13);
+    }
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status)) << "child killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+#endif
+}
+
+TEST(ThreadStartLimits, RunReplayAndCompareWithTooManyThreadsAreOneLine) {
+#ifdef SIMGRASS_TEST_ASAN
+  GTEST_SKIP() << "an address-space limit and AddressSanitizer's shadow memory do not mix";
+#else
+  TempDir dir;
+  const std::string rec = test::sourcePath("tests/data/sgr/tiny.sgr");
+  for (const std::string& args : {"run " + quote(tinyScenario()) + " --threads 256 --ticks 3",
+                                  "replay " + quote(rec) + " --threads 256",
+                                  "compare " + quote(rec) + " --threads 240 --variant interp=2"}) {
+    const std::string out = dir.file("out"), err = dir.file("err");
+    const std::string cmd = "(ulimit -v 1500000; timeout -k 5 60 " + quote(SIMGRASS_CLI) + " " + args +
+                            " </dev/null >" + quote(out) + " 2>" + quote(err) + ")";
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status)) << args;
+    const std::string stderrText = readFile(err);
+    EXPECT_EQ(WEXITSTATUS(status), 2) << args << "\n" << stderrText;
+    EXPECT_TRUE(isOneLine(stderrText)) << args;
+    EXPECT_TRUE(contains(stderrText, "--threads: expected a thread count this machine can start (created "))
+        << args << "\n" << stderrText;
+  }
+#endif
+}
+
+}  // namespace
+}  // namespace sg
