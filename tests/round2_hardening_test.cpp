@@ -73,9 +73,9 @@ TEST(ThreadStartLimits, RunReplayAndCompareWithTooManyThreadsAreOneLine) {
 #else
   TempDir dir;
   const std::string rec = test::sourcePath("tests/data/sgr/tiny.sgr");
-  for (const std::string& args : {"run " + quote(tinyScenario()) + " --threads 256 --ticks 3",
-                                  "replay " + quote(rec) + " --threads 256",
-                                  "compare " + quote(rec) + " --threads 240 --variant interp=2"}) {
+  for (const std::string& args :
+       {"run " + quote(tinyScenario()) + " --threads 256 --ticks 3", "replay " + quote(rec) + " --threads 256",
+        "compare " + quote(rec) + " --threads 240 --variant interp=2"}) {
     const std::string out = dir.file("out"), err = dir.file("err");
     const std::string cmd = "(ulimit -v 1500000; timeout -k 5 60 " + quote(SIMGRASS_CLI) + " " + args +
                             " </dev/null >" + quote(out) + " 2>" + quote(err) + ")";
@@ -85,8 +85,35 @@ TEST(ThreadStartLimits, RunReplayAndCompareWithTooManyThreadsAreOneLine) {
     EXPECT_EQ(WEXITSTATUS(status), 2) << args << "\n" << stderrText;
     EXPECT_TRUE(isOneLine(stderrText)) << args;
     EXPECT_TRUE(contains(stderrText, "--threads: expected a thread count this machine can start (created "))
-        << args << "\n" << stderrText;
+        << args << "\n"
+        << stderrText;
   }
+#endif
+}
+
+// --- worlds larger than this process may allocate ------------------------------------------
+
+// Under ulimit -v the memory budget is the address-space limit: a 1048576 x 64 field (about
+// 9 GiB) is refused by the estimate, naming the file, where `record` printed "internal error:
+// out of memory".
+TEST(WorldMemoryLimits, RecordRefusesAFieldLargerThanTheAddressSpaceLimit) {
+#ifdef SIMGRASS_TEST_ASAN
+  GTEST_SKIP() << "an address-space limit and AddressSanitizer's shadow memory do not mix";
+#else
+  TempDir dir;
+  const std::string scenario = dir.write("bigf.json", R"({"field":{"patchesX":1048576,"patchesZ":64,"spacing":0.25}})");
+  const std::string out = dir.file("out"), err = dir.file("err");
+  const std::string cmd = "(ulimit -v 4000000; timeout -k 5 60 " + quote(SIMGRASS_CLI) + " record " + quote(scenario) +
+                          " -o " + quote(dir.file("big.sgr")) + " --ticks 1 </dev/null >" + quote(out) + " 2>" +
+                          quote(err) + ")";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  const std::string stderrText = readFile(err);
+  EXPECT_EQ(WEXITSTATUS(status), 2) << stderrText;
+  EXPECT_TRUE(isOneLine(stderrText));
+  EXPECT_TRUE(contains(stderrText, "simgrass record: " + scenario + ": $.field: expected ")) << stderrText;
+  EXPECT_FALSE(contains(stderrText, "internal error")) << stderrText;
+  EXPECT_FALSE(fs::exists(dir.file("big.sgr")));
 #endif
 }
 
