@@ -117,5 +117,39 @@ TEST(WorldMemoryLimits, RecordRefusesAFieldLargerThanTheAddressSpaceLimit) {
 #endif
 }
 
+// --- integer options are decimal -----------------------------------------------------------
+
+TEST(DecimalOptions, LeadingZerosAreDecimalNotOctal) {
+  const CliResult r = runCli("run " + quote(tinyScenario()) + " --ticks 010 --json");
+  ASSERT_EQ(r.exitCode, 0) << r.describe();
+  EXPECT_EQ(parseJson(r)["ticks"], 10) << r.describe();  // CLI11 alone: 8 (octal)
+  const CliResult replay = runCli("replay " + quote(test::sourcePath("tests/data/sgr/tiny.sgr")) + " --to 010");
+  ASSERT_EQ(replay.exitCode, 0) << replay.describe();
+  EXPECT_TRUE(contains(replay.out, "tick 10 hash")) << replay.describe();
+}
+
+TEST(DecimalOptions, HexOctalAndBinarySpellingsAreRefusedInOneLine) {
+  for (const std::string& args :
+       {"run " + quote(tinyScenario()) + " --ticks 0x10", "run " + quote(tinyScenario()) + " --threads 0b11",
+        "run " + quote(tinyScenario()) + " --ticks 0o7",
+        "replay " + quote(test::sourcePath("tests/data/sgr/tiny.sgr")) + " --to 0x1"}) {
+    const CliResult r = runCli(args);
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.describe();
+    EXPECT_TRUE(isOneLine(r.err)) << args;
+    EXPECT_TRUE(contains(r.err, "expected a decimal integer")) << args << "\n" << r.describe();
+  }
+  // A leading-zero value still meets the option's range: 0257 is 257, above --threads' 256.
+  const CliResult r = runCli("run " + quote(tinyScenario()) + " --threads 0257");
+  EXPECT_EQ(r.exitCode, 2) << r.describe();
+}
+
+// CLI11 echoed a 5000-character option value whole.
+TEST(DecimalOptions, ParseErrorsCutTheEchoedValue) {
+  const CliResult r = runCli("run " + quote(tinyScenario()) + " --scalar " + std::string(5000, 'x'));
+  EXPECT_EQ(r.exitCode, 2) << r.describe();
+  EXPECT_TRUE(isOneLine(r.err));
+  EXPECT_LT(r.err.size(), 400u) << r.err.size();
+}
+
 }  // namespace
 }  // namespace sg
