@@ -151,5 +151,45 @@ TEST(DecimalOptions, ParseErrorsCutTheEchoedValue) {
   EXPECT_LT(r.err.size(), 400u) << r.err.size();
 }
 
+// --- NUL bytes and control characters ------------------------------------------------------
+
+// nlohmann's lexer ends the input at a NUL: the garbage after it was silently ignored (exit 0).
+TEST(NulBytes, ScenarioAndInputTrackWithANulAfterTheValueAreRefusedAtItsByte) {
+  TempDir dir;
+  const std::string text = std::string(R"({"field":{"patchesX":4,"patchesZ":4}})") + '\0' + "GARBAGE {{";
+  const std::string scenario = dir.write("nul.json", text);
+  const CliResult r = runCli("run " + quote(scenario) + " --ticks 1");
+  EXPECT_EQ(r.exitCode, 2) << r.describe();
+  EXPECT_TRUE(isOneLine(r.err));
+  EXPECT_TRUE(contains(r.err, scenario + ": byte 38 (line 1, column 38): expected valid JSON")) << r.describe();
+
+  const std::string track = dir.write("track.json", std::string(R"({"ticks": 2})") + '\0' + "junk");
+  const CliResult t =
+      runCli("record " + quote(tinyScenario()) + " --input " + quote(track) + " -o " + quote(dir.file("t.sgr")));
+  EXPECT_EQ(t.exitCode, 2) << t.describe();
+  EXPECT_TRUE(isOneLine(t.err));
+  EXPECT_TRUE(contains(t.err, track + ": byte 13")) << t.describe();
+  EXPECT_FALSE(fs::exists(dir.file("t.sgr")));
+}
+
+// "ok.png\u0000junk" read ok.png (and record embedded the longer name).
+TEST(NulBytes, FileNamesWithControlCharactersAreRefusedWithTheirPath) {
+  TempDir dir;
+  const std::string heightmap =
+      dir.write("hm.json", R"({"terrain":{"type":"heightmap","file":"ok.png\u0000junk","cellSize":1,"maxHeight":1}})");
+  const CliResult r = runCli("run " + quote(heightmap) + " --ticks 1");
+  EXPECT_EQ(r.exitCode, 2) << r.describe();
+  EXPECT_TRUE(isOneLine(r.err));
+  EXPECT_TRUE(contains(r.err, "$.terrain.file: expected a file name without control characters")) << r.describe();
+
+  const std::string mesh =
+      dir.write("mesh.json",
+                R"({"bodies":{"list":[{"name":"rock","shape":{"type":"sphere","radius":0.5},"mesh":"a\u0001.obj"}]}})");
+  const CliResult m = runCli("run " + quote(mesh) + " --ticks 1");
+  EXPECT_EQ(m.exitCode, 2) << m.describe();
+  EXPECT_TRUE(isOneLine(m.err));
+  EXPECT_TRUE(contains(m.err, ".mesh: expected a file name without control characters")) << m.describe();
+}
+
 }  // namespace
 }  // namespace sg
