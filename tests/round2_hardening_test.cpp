@@ -191,5 +191,26 @@ TEST(NulBytes, FileNamesWithControlCharactersAreRefusedWithTheirPath) {
   EXPECT_TRUE(contains(m.err, ".mesh: expected a file name without control characters")) << m.describe();
 }
 
+// --- limits and messages ---------------------------------------------------------------------
+
+// A 64 MiB track of "[]" peaked at 1.6 GB: the track limit is 16 MiB.
+TEST(Round2Limits, InputTrackAbove16MiBIsRefusedBeforeItIsRead) {
+  TempDir dir;
+  const std::string track = dir.write("track.json", std::string((16u << 20) + 1, ' ') + "{}");
+  const CliResult r = runCli("record " + quote(tinyScenario()) + " --input " + quote(track) + " -o " +
+                             quote(dir.file("t.sgr")) + " --ticks 1");
+  EXPECT_EQ(r.exitCode, 2) << r.describe();
+  EXPECT_TRUE(isOneLine(r.err));
+  EXPECT_TRUE(contains(r.err, track + ": $: expected a file of at most 16777216 bytes")) << r.describe();
+}
+
+TEST(Round2Limits, VariantNamingASettingTwiceIsRefused) {
+  const CliResult r =
+      runCli("compare " + quote(test::sourcePath("tests/data/sgr/tiny.sgr")) + " --variant scalar=fx16,scalar=double");
+  EXPECT_EQ(r.exitCode, 2) << r.describe();
+  EXPECT_TRUE(isOneLine(r.err));
+  EXPECT_TRUE(contains(r.err, "expected each key once (scalar is given twice)")) << r.describe();
+}
+
 }  // namespace
 }  // namespace sg
