@@ -212,5 +212,16 @@ TEST(Round2Limits, VariantNamingASettingTwiceIsRefused) {
   EXPECT_TRUE(contains(r.err, "expected each key once (scalar is given twice)")) << r.describe();
 }
 
+// The docs say below 2^40: 2^40 itself was accepted.
+TEST(Round2Limits, InputTrackTicksOf2Pow40AreRefused) {
+  TempDir dir;
+  const std::string track = dir.write("track.json", R"({"format": "simgrass-input-track/1", "ticks": 1099511627776})");
+  const CliResult r =
+      runCli("record " + quote(tinyScenario()) + " --input " + quote(track) + " -o " + quote(dir.file("t.sgr")));
+  EXPECT_EQ(r.exitCode, 2) << r.describe();
+  EXPECT_TRUE(isOneLine(r.err));
+  EXPECT_TRUE(contains(r.err, track + ": $.ticks: expected an integer from 0 to 1099511627775")) << r.describe();
+}
+
 }  // namespace
 }  // namespace sg

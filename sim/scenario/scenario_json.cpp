@@ -753,7 +753,7 @@ InputTrack parseInputTrack(const std::string& text, const std::string& sourceNam
   r.object(root, "$", {"format", "ticks", "camera", "commands"});
   if (!root.contains("format") || root["format"] != "simgrass-input-track/1")
     r.failGot("$.format", "\"simgrass-input-track/1\"", root.contains("format") ? root["format"] : json());
-  if (root.contains("ticks")) track.ticks = r.integer(root["ticks"], "$.ticks", 0, int64_t(1) << 40);
+  if (root.contains("ticks")) track.ticks = r.integer(root["ticks"], "$.ticks", 0, (int64_t(1) << 40) - 1);
   if (root.contains("camera")) parseCamera(r, root["camera"], "$.camera", track.camera);
   if (root.contains("commands")) parseScript(r, root["commands"], scenario, "$.commands", track.commands);
   validateInputTrack(track, scenario.scalar);
