@@ -21,12 +21,13 @@ namespace sg {
 
 /// The documented input limits (docs/robustness.md lists them; change both together).
 struct InputLimits {
-  static constexpr uint64_t kScenarioBytes = uint64_t(16) << 20;    ///< scenario JSON
-  static constexpr uint64_t kHeightmapBytes = uint64_t(64) << 20;   ///< heightmap PNG
-  static constexpr uint64_t kInputTrackBytes = uint64_t(64) << 20;  ///< input-track JSON
-  static constexpr uint64_t kMeshBytes = uint64_t(64) << 20;        ///< OBJ mesh
-  static constexpr uint64_t kScriptBytes = uint64_t(4) << 20;       ///< viewer script
-  static constexpr uint64_t kRecordingBytes = uint64_t(16) << 30;   ///< .sgr recording
+  static constexpr uint64_t kScenarioBytes = uint64_t(16) << 20;   ///< scenario JSON
+  static constexpr uint64_t kHeightmapBytes = uint64_t(64) << 20;  ///< heightmap PNG
+  static constexpr uint64_t kInputTrackBytes = uint64_t(16)
+                                               << 20;          ///< input-track JSON (nlohmann peaks at ~25x the text)
+  static constexpr uint64_t kMeshBytes = uint64_t(64) << 20;   ///< OBJ mesh
+  static constexpr uint64_t kScriptBytes = uint64_t(4) << 20;  ///< viewer script
+  static constexpr uint64_t kRecordingBytes = uint64_t(16) << 30;  ///< .sgr recording
 };
 
 /// An open, regular, bounded input file. Move-only; closes on destruction.

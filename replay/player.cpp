@@ -69,7 +69,7 @@ Player::Player(const sgr::Recording& recording, int threads, const VariantSettin
   try {
     // The machine's memory is the budget (as for `simgrass record`): a recording whose scenario
     // asks for more is an error here, not a failed allocation later.
-    world_ = makeWorld(scenario_, threads_, physicalMemoryBytes());
+    world_ = makeWorldWithinMemory(scenario_, threads_);
   } catch (const ScenarioError& e) {
     throw sgr::RecordingError(recording.file, sgr::kPreambleBytes,
                               std::string("a scenario this build can run: ") + e.what());
@@ -89,7 +89,7 @@ Player::Player(const sgr::Recording& recording, int threads, const VariantSettin
                               "the physics or the scenario format changed since it was recorded)");
 }
 
-void Player::restart() { world_ = makeWorld(scenario_, threads_); }
+void Player::restart() { world_ = makeWorldWithinMemory(scenario_, threads_); }
 
 StepResult Player::stepForward(StageObserver* observer) {
   return world_->step(recording_.inputAt(world_->tick()), observer);

@@ -16,7 +16,7 @@ struct RecordingSession::Impl {
   /// What `simgrass record` does between loading the scenario and its first step: the world
   /// under the machine's memory budget, the default hash interval for its size, then HEAD.
   Impl(Scenario s, std::vector<sgr::EmbeddedFile> files, const std::string& output, const RecordingSettings& settings)
-      : scenario(std::move(s)), world(makeWorld(scenario, settings.threads, physicalMemoryBytes())) {
+      : scenario(std::move(s)), world(makeWorldWithinMemory(scenario, settings.threads)) {
     RecordSettings record;
     record.checkEvery = settings.checkEvery ? *settings.checkEvery : defaultCheckEvery(world->counts().patches());
     record.snapshotEvery = settings.snapshotEvery;

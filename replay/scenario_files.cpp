@@ -2,6 +2,7 @@
 
 #include "replay/input_file.h"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -9,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <new>
 
 namespace sg {
 
@@ -47,6 +49,19 @@ std::vector<std::string> filesNamedBy(const Scenario& scenario, const std::vecto
 
 uint64_t physicalMemoryBytes() {
   const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && size > 0 ? uint64_t(pages) * uint64_t(size) : 0;
+  uint64_t bytes = pages > 0 && size > 0 ? uint64_t(pages) * uint64_t(size) : 0;
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY && (bytes == 0 || limit.rlim_cur < bytes))
+    bytes = uint64_t(limit.rlim_cur);
+  return bytes;
+}
+
+std::unique_ptr<SimWorld> makeWorldWithinMemory(const Scenario& scenario, int threads) {
+  try {
+    return makeWorld(scenario, threads, physicalMemoryBytes());
+  } catch (const std::bad_alloc&) {
+    throw ScenarioError(scenario.sourceName.empty() ? "<built-in>" : scenario.sourceName, "$.field",
+                        "a field that fits in memory (allocation failed)");
+  }
 }
 }  // namespace sg

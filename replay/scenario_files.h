@@ -3,11 +3,13 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "replay/format/sgr_format.h"
 #include "sim/scenario/scenario.h"
+#include "sim/world/sim_world.h"
 
 namespace sg {
 
@@ -22,7 +24,13 @@ Scenario loadScenarioFile(const std::string& path, std::vector<sgr::EmbeddedFile
 std::vector<std::string> filesNamedBy(const Scenario& scenario, const std::vector<sgr::EmbeddedFile>& files,
                                       const std::string& folder);
 
-/// Physical memory of this machine in bytes (the default memory budget for a world).
+/// Memory this process may use in bytes (the default memory budget for a world): the machine's
+/// physical memory, or the address-space limit (ulimit -v) when that is lower.
 uint64_t physicalMemoryBytes();
+
+/// makeWorld under physicalMemoryBytes(), with an allocation that fails anyway (the estimate is
+/// a lower bound) turned into the ScenarioError `run` prints:
+/// "file: $.field: expected a field that fits in memory (allocation failed)".
+std::unique_ptr<SimWorld> makeWorldWithinMemory(const Scenario& scenario, int threads);
 
 }  // namespace sg

@@ -1,5 +1,6 @@
 #include "replay/variant.h"
 
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -19,11 +20,14 @@ VariantSettings VariantSettings::parse(const std::string& text) {
     if (ch == ',') ch = ' ';
   std::istringstream in(spaced);
   std::string item;
+  std::set<std::string> seen;
   while (in >> item) {
     const size_t eq = item.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
       bad(item, "key=value with a key scalar, interp, broadphase, body-broadphase, dt, lod or threads");
     const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
+    // "scalar=fx16,scalar=double" silently took the last: a variant names each setting once.
+    if (!seen.insert(key).second) bad(item, "each key once (" + key + " is given twice)");
     if (key == "scalar") {
       const auto kind = parseScalarKind(value);
       if (!kind) bad(item, "scalar=fx32, fx16, float or double");

@@ -18,12 +18,38 @@
 #include "replay/cli/run_command.h"
 #include "replay/cli/sweep_command.h"
 #include "replay/kernel_environment.h"
+#include "sim/scenario/json_bounds.h"
+#include "sim/world/chunk_pool.h"
 
 namespace {
 /// The subcommand being run ("replay"), or "" before one was parsed.
 std::string commandName(const CLI::App& app) {
   for (const CLI::App* sub : app.get_subcommands()) return sub->get_name();
   return "";
+}
+
+/// Integer options read as decimal: CLI11 reads "010" as octal 8 and "0x10" as 16, a silently
+/// different run. Every integer option of every subcommand gets a transform, run before its
+/// range check, that keeps an optional sign and decimal digits (leading zeros dropped, so
+/// "010" is 10) and refuses anything else.
+void makeIntegerOptionsDecimal(CLI::App& app) {
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) makeIntegerOptionsDecimal(*sub);
+  for (CLI::Option* opt : app.get_options([](CLI::Option*) { return true; })) {
+    const std::string type = opt->get_type_name();
+    if (type.rfind("INT", 0) != 0 && type.rfind("UINT", 0) != 0) continue;
+    opt->transform(CLI::Validator(
+        [](std::string& value) -> std::string {
+          size_t i = value.empty() || (value[0] != '-' && value[0] != '+') ? 0 : 1;
+          const size_t digits = i;
+          bool ok = i < value.size();
+          for (size_t k = i; k < value.size(); ++k) ok = ok && value[k] >= '0' && value[k] <= '9';
+          if (!ok) return "expected a decimal integer, got '" + sg::echoText(value) + "'";
+          while (i + 1 < value.size() && value[i] == '0') ++i;
+          value = value.substr(0, digits) + value.substr(i);
+          return "";
+        },
+        "", "decimal"));
+  }
 }
 }  // namespace
 
@@ -46,6 +72,7 @@ int main(int argc, char** argv) {
   sg::addCompareCommand(app, &exitCode);
   sg::addSweepCommand(app, &exitCode);
   sg::addRenderCommand(app, &exitCode);  // the viewer's, or a stub in a build without it
+  makeIntegerOptionsDecimal(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -56,7 +83,13 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     // One line, non-zero: the command-line counterpart of a bad scenario.
-    sg::printError("simgrass: %s (see 'simgrass --help')", e.what());
+    // CLI11 echoes option values whole: cut, so a 5000-character value is not a 5000-byte line.
+    sg::printError("simgrass: %s (see 'simgrass --help')", sg::echoText(e.what(), 240).c_str());
+    return 2;
+  } catch (const sg::ThreadStartError& e) {
+    // --threads larger than the machine lets this process start (ulimit -u, address space).
+    const std::string cmd = commandName(app);
+    sg::printError("simgrass%s%s: %s", cmd.empty() ? "" : " ", cmd.c_str(), e.what());
     return 2;
   } catch (const std::bad_alloc&) {
     // Last resort: every input is bounded before it is allocated for, so this is a bug (or a

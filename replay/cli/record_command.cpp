@@ -58,7 +58,7 @@ int record(const RecordOptions& o) {
         throw ScenarioError(o.inputTrack, "$", why);
       track = parseInputTrack(text, o.inputTrack, scenario);
     }
-    world = makeWorld(scenario, o.threads, physicalMemoryBytes());
+    world = makeWorldWithinMemory(scenario, o.threads);
   } catch (const std::invalid_argument& e) {
     printError("simgrass record: --variant %s\n", e.what());
     return kExitBadInput;

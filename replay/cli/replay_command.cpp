@@ -138,7 +138,7 @@ int replay(const ReplayOptions& o) {
       bar.finish();
       if (!r.ok) {
         faulted = true;
-        printError("simgrass replay: %s%s\n", r.error.message().c_str(), noStateWritten.c_str());
+        printError("simgrass replay: %s: %s%s\n", o.file.c_str(), r.error.message().c_str(), noStateWritten.c_str());
         out["error"] = r.error.message();
         code = kExitMismatch;
       }

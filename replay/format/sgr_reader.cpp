@@ -447,9 +447,14 @@ Recording readRecording(const std::string& path, uint64_t maxBytes) {
         checkChunkHeader(type, loadLE<uint32_t>(first.data() + kPreambleBytes + 4), kPreambleBytes, path);
     if (t != ChunkType::Head) throw RecordingError(path, kPreambleBytes, "the HEAD chunk first");
   }
-  std::vector<uint8_t> bytes;
-  if (!in.readAll(&bytes, &expected)) throw RecordingError(path, 0, expected);
-  return parseRecording(std::move(bytes), path);
+  try {
+    std::vector<uint8_t> bytes;
+    if (!in.readAll(&bytes, &expected)) throw RecordingError(path, 0, expected);
+    return parseRecording(std::move(bytes), path);
+  } catch (const std::bad_alloc&) {
+    // Below kRecordingBytes, but more than this process may allocate (ulimit -v, a small machine).
+    throw RecordingError(path, 0, "a recording that fits in memory (" + std::to_string(in.size()) + " bytes)");
+  }
 }
 
 bool hasRecordingMagic(const std::string& path) {

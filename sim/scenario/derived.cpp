@@ -15,7 +15,7 @@ class Checked {
   }
   int64_t ticks(std::optional<Rational> r, const std::string& path) const {
     auto n = (*this)(r, path).roundToInt64();
-    if (!n || *n > (int64_t(1) << 40)) throw ScenarioError(s_.sourceName, path, "a duration below 2^40 ticks");
+    if (!n || *n >= (int64_t(1) << 40)) throw ScenarioError(s_.sourceName, path, "a duration below 2^40 ticks");
     return *n;
   }
 

@@ -222,6 +222,18 @@ class Reader {
     if (!j.is_string()) fail(path, std::string("a string, got ") + typeName(j));
     return j.get<std::string>();
   }
+  /// A string naming a file: no control character (a "\u0000" would cut the name where the
+  /// file is opened, reading "ok.png" for "ok.png\u0000junk" and recording the longer name).
+  std::string fileName(const json& j, const std::string& path) const {
+    std::string name = string(j, path);
+    for (size_t i = 0; i < name.size(); ++i) {
+      const auto c = static_cast<unsigned char>(name[i]);
+      if (c < 0x20 || c == 0x7f)
+        fail(path, "a file name without control characters, got '" + echoText(name) + "' (character " +
+                       std::to_string(i + 1) + ")");
+    }
+    return name;
+  }
   template <class E>
   E choice(const json& j, const std::string& path, std::initializer_list<std::pair<const char*, E>> options) const {
     std::string list;
@@ -319,7 +331,7 @@ void parseTerrain(const Reader& r, const json& j, Scenario::Terrain& t, const Sc
   }
   if (j.contains("height")) r.fail(p + ".height", "no 'height' for a heightmap terrain (use maxHeight)");
   if (!j.contains("file")) r.fail(p + ".file", "the heightmap PNG file name (missing)");
-  t.heightmapPath = r.string(j["file"], p + ".file");
+  t.heightmapPath = r.fileName(j["file"], p + ".file");
   if (j.contains("cellSize")) t.cellSize = r.positive(j["cellSize"], p + ".cellSize");
   if (j.contains("maxHeight")) t.maxHeight = r.nonNegative(j["maxHeight"], p + ".maxHeight");
   r.center(j, p, &t.centerX, &t.centerZ);
@@ -429,7 +441,7 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
     b.canSleep = j["canSleep"].get<bool>();
   }
   // Looks only (the renderer loads it); stored as written, never part of the fingerprint.
-  if (j.contains("mesh")) b.mesh = r.string(j["mesh"], p + ".mesh");
+  if (j.contains("mesh")) b.mesh = r.fileName(j["mesh"], p + ".mesh");
   return b;
 }
 
@@ -608,6 +620,11 @@ namespace {
 /// Parses JSON text, reporting the byte and line of a syntax error and the path of a number that
 /// overflows; `raw` receives every number as written (for exact rationals).
 json loadJson(const std::string& text, const std::string& sourceName, std::map<std::string, std::string>* raw) {
+  // nlohmann's lexer takes a NUL byte for the end of the input: "{...}\0GARBAGE {{" would parse.
+  // Nothing but whitespace may follow the value, and a NUL inside it is no JSON either.
+  if (const size_t nul = text.find('\0'); nul != std::string::npos)
+    throw ScenarioError(sourceName, "byte " + std::to_string(nul + 1) + " (" + lineColumn(text, nul) + ")",
+                        "valid JSON (a NUL byte; nothing but whitespace may follow the value)");
   // The SAX pass first: it knows the JSON path of a number that overflows a double.
   RawNumberCollector collector;
   const bool wellFormed = json::sax_parse(text, &collector);
@@ -736,7 +753,7 @@ InputTrack parseInputTrack(const std::string& text, const std::string& sourceNam
   r.object(root, "$", {"format", "ticks", "camera", "commands"});
   if (!root.contains("format") || root["format"] != "simgrass-input-track/1")
     r.failGot("$.format", "\"simgrass-input-track/1\"", root.contains("format") ? root["format"] : json());
-  if (root.contains("ticks")) track.ticks = r.integer(root["ticks"], "$.ticks", 0, int64_t(1) << 40);
+  if (root.contains("ticks")) track.ticks = r.integer(root["ticks"], "$.ticks", 0, (int64_t(1) << 40) - 1);
   if (root.contains("camera")) parseCamera(r, root["camera"], "$.camera", track.camera);
   if (root.contains("commands")) parseScript(r, root["commands"], scenario, "$.commands", track.commands);
   validateInputTrack(track, scenario.scalar);

@@ -14,7 +14,7 @@ namespace {
 constexpr size_t kMaxChunkBytes = size_t(1) << 20;
 constexpr size_t kMaxChunkCacheBytes = size_t(4) << 20;
 /// Heightmap sides (samples); scenario_json.cpp may cap the total further.
-constexpr uint32_t kMinSide = 2, kMaxSide = 16384;
+constexpr uint32_t kMinSide = 2, kMaxSide = 4096;  // = kMaxHeightmapSide (sim/scenario/scenario.h)
 
 struct ContextFree {
   void operator()(spng_ctx* ctx) const { spng_ctx_free(ctx); }
@@ -82,10 +82,10 @@ bool decodeHeightmapPng(std::span<const uint8_t> bytes, Heightmap* out, std::str
     return false;
   }
   // The size is checked before anything is decoded: the decoded image is width*height bytes, so
-  // this bounds the one large allocation (256 MiB at 16384x16384). It is done here rather than
+  // this bounds the one large allocation (16 MiB at 4096x4096). It is done here rather than
   // with spng_set_image_limits, whose error would hide the declared size from the message.
   if (ihdr.width < kMinSide || ihdr.height < kMinSide || ihdr.width > kMaxSide || ihdr.height > kMaxSide) {
-    *error = "a heightmap between 2x2 and 16384x16384 samples, got " + std::to_string(ihdr.width) + "x" +
+    *error = "a heightmap between 2x2 and 4096x4096 samples, got " + std::to_string(ihdr.width) + "x" +
              std::to_string(ihdr.height);
     return false;
   }

@@ -1,12 +1,27 @@
 #include "sim/world/chunk_pool.h"
 
+#include <exception>
+#include <string>
+
 namespace sg {
 
 ChunkPool::ChunkPool(int threads) {
-  for (int w = 1; w < threads; ++w) workers_.emplace_back([this, w] { workerLoop(w); });
+  try {
+    workers_.reserve(size_t(threads > 1 ? threads - 1 : 0));
+    for (int w = 1; w < threads; ++w) workers_.emplace_back([this, w] { workerLoop(w); });
+  } catch (const std::exception&) {
+    // The workers already started wait on wake_: they must be stopped and joined before the
+    // members die (destroying a condition variable with waiters hangs), then the caller learns
+    // how many the machine would start.
+    const int created = int(workers_.size()) + 1;
+    stopAndJoin();
+    throw ThreadStartError(created, threads);
+  }
 }
 
-ChunkPool::~ChunkPool() {
+ChunkPool::~ChunkPool() { stopAndJoin(); }
+
+void ChunkPool::stopAndJoin() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;

@@ -8,10 +8,28 @@
 #include <cstdint>
 #include <functional>
 #include <mutex>
+#include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
 namespace sg {
+
+/// Thrown by ChunkPool when the machine refuses to start one of the requested threads
+/// (RLIMIT_NPROC, address space for the stacks): the workers already started are joined first.
+class ThreadStartError : public std::runtime_error {
+ public:
+  ThreadStartError(int created, int requested)
+      : std::runtime_error("--threads: expected a thread count this machine can start (created " +
+                           std::to_string(created) + " of " + std::to_string(requested) + ")"),
+        created_(created),
+        requested_(requested) {}
+  int created() const { return created_; }
+  int requested() const { return requested_; }
+
+ private:
+  int created_, requested_;
+};
 
 class ChunkPool {
  public:
@@ -30,6 +48,7 @@ class ChunkPool {
  private:
   void workerLoop(int worker);
   void drain(int worker);
+  void stopAndJoin();
 
   std::vector<std::thread> workers_;
   std::mutex mutex_;
