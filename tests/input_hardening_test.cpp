@@ -348,6 +348,10 @@ TEST(ScenarioDerived, AValueWhoseDerivedConstantOverflowsIsNamedAsSuch) {
                           "whose 1/mass is within the fx32 range"));
   EXPECT_TRUE(throwsError(build(R"({"particles": {"mass": 6e8}})"), "$.particles.mass",
                           "expected a value within the fx32 range"));
+  // A spacing so wide that a gust takes 2^40 ticks to cross the field: the message names the
+  // spacing as well as the travel speed it is reported at.
+  EXPECT_TRUE(throwsError(build(R"({"scalar": "double", "field": {"spacing": 1e13}})"), "$.wind.travelSpeed",
+                          "a gust crossing of the field (rows x field.spacing"));
 }
 
 // ---- 7. heightmap size cap and memory estimate ------------------------------------------------

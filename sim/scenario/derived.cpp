@@ -13,9 +13,11 @@ class Checked {
                           "(write it with fewer significant digits)");
     return *r;
   }
-  int64_t ticks(std::optional<Rational> r, const std::string& path) const {
+  /// `what` names the duration when it is derived from more than the value at `path`.
+  int64_t ticks(std::optional<Rational> r, const std::string& path, const char* what = "a duration") const {
     auto n = (*this)(r, path).roundToInt64();
-    if (!n || *n >= (int64_t(1) << 40)) throw ScenarioError(s_.sourceName, path, "a duration below 2^40 ticks");
+    if (!n || *n >= (int64_t(1) << 40))
+      throw ScenarioError(s_.sourceName, path, std::string(what) + " below 2^40 ticks");
     return *n;
   }
 
@@ -65,7 +67,9 @@ ScenarioConstants deriveConstants(const Scenario& s) {
       ok(div(rowSpacing, ok(mul(s.wind.travelSpeed, s.timeStep), "$.wind.travelSpeed")), "$.wind.travelSpeed");
   c.rowDelayTicks.resize(size_t(c.particlesZ));
   for (int64_t r = 0; r < c.particlesZ; ++r)
-    c.rowDelayTicks[size_t(r)] = ok.ticks(mul(ticksPerRow, Rational::integer(r)), "$.wind.travelSpeed");
+    c.rowDelayTicks[size_t(r)] =
+        ok.ticks(mul(ticksPerRow, Rational::integer(r)), "$.wind.travelSpeed",
+                 "a gust crossing of the field (rows x field.spacing x interpolation / (travelSpeed x timeStep))");
 
   if (!s.terrain.flat) {
     const auto& t = s.terrain;
