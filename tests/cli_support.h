@@ -9,11 +9,13 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 namespace sg {
 namespace fs = std::filesystem;
@@ -48,6 +50,16 @@ class TempDir {
 inline std::string readFile(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// A file's bytes (empty when it cannot be read), and bytes written over a file.
+inline std::vector<uint8_t> readBytes(const std::string& path) {
+  const std::string s = readFile(path);
+  return std::vector<uint8_t>(s.begin(), s.end());
+}
+inline void writeBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
 }
 
 inline std::string quote(const std::string& s) {

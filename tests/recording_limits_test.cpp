@@ -40,16 +40,6 @@ bool contains(const std::string& s, const std::string& part) { return s.find(par
 std::string tinyRecording() { return test::sourcePath("tests/data/sgr/tiny.sgr"); }
 std::string tinyScenario() { return test::sourcePath("tests/data/sgr/tiny.json"); }
 
-std::vector<uint8_t> readBytes(const std::string& path) {
-  const std::string s = readFile(path);
-  return std::vector<uint8_t>(s.begin(), s.end());
-}
-
-void writeBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-}
-
 /// A chunk of a sound recording: its type and payload (framed again, with a fresh checksum, by
 /// assemble()).
 struct Chunk {

@@ -45,16 +45,6 @@ std::string tinyRecording() { return test::sourcePath("tests/data/sgr/tiny.sgr")
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
-std::vector<uint8_t> readBytes(const std::string& path) {
-  const std::string s = readFile(path);
-  return std::vector<uint8_t>(s.begin(), s.end());
-}
-
-void writeBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-}
-
 /// One entry of EXPECTED.json.
 struct Expectation {
   std::string file, kind, outcome, message;

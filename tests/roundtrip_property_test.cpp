@@ -80,16 +80,6 @@ std::vector<uint64_t> scriptedHashes(SimWorld& world, const Scenario& s, int64_t
   return hashes;
 }
 
-std::vector<uint8_t> readBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void writeBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-}
-
 /// One random edit of `bytes`: flip bits, overwrite a run, cut, insert or delete a range.
 std::vector<uint8_t> mutate(std::vector<uint8_t> bytes) {
   const int edits = *rc::gen::inRange(1, 4);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "replay/input_file.h"
+#include "sim/scenario/json_bounds.h"
 
 namespace sg {
 
@@ -21,32 +22,8 @@ inline std::string hex(uint64_t h) {
   return buf;
 }
 
-/// `text` with every control character escaped (\n, \r, \t, \xNN): what a one-line message
-/// prints of a file name or an error text, so that a newline in either cannot split the line.
-inline std::string escapeControl(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (const char ch : text) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c == '\n') {
-      out += "\\n";
-    } else if (c == '\r') {
-      out += "\\r";
-    } else if (c == '\t') {
-      out += "\\t";
-    } else if (c < 0x20 || c == 0x7f) {
-      char buf[5];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += buf;
-    } else {
-      out += ch;
-    }
-  }
-  return out;
-}
-
 /// A user-given value as an error message echoes it: at most 60 bytes, then "...".
-inline std::string echoed(const std::string& value) { return value.size() <= 60 ? value : value.substr(0, 60) + "..."; }
+inline std::string echoed(const std::string& value) { return echoText(value); }
 
 /// Prints one line on stderr: the printf-formatted text (a trailing newline in `format` is
 /// optional) with every control character in it escaped, then one newline. Every error and

@@ -82,6 +82,13 @@ void render(const json& v, std::string& out, size_t budget, int level) {
 }
 }  // namespace
 
+std::string escapeControl(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  appendEscaped(out, text);
+  return out;
+}
+
 std::optional<size_t> findExcessNesting(std::string_view text, int maxDepth) {
   int depth = 0;
   bool inString = false, escaped = false;

@@ -33,6 +33,10 @@ std::optional<size_t> findExcessNesting(std::string_view text, int maxDepth = kM
 /// recursion and stopping once it exceeds `limit` (returns limit + 1 then).
 int jsonDepth(const nlohmann::json& value, int limit = kMaxJsonDepth);
 
+/// `text` with every control character escaped (\n, \r, \t, \xNN; also DEL), whole: what a
+/// one-line message prints of a file name or an error text, so that a newline cannot split it.
+std::string escapeControl(std::string_view text);
+
 /// `text` with every control character escaped (\n, \r, \t, \xNN; also DEL), cut to at most
 /// `maxChars` characters of the original followed by "..." when longer. Never splits a line.
 std::string echoText(std::string_view text, size_t maxChars = kEchoChars);

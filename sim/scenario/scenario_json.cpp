@@ -590,31 +590,8 @@ std::string lineColumn(const std::string& text, size_t byte) {
 }
 }  // namespace
 
-namespace {
-/// Escapes control characters (a newline in a key or file name must not split the line).
-std::string oneLine(const std::string& s) {
-  std::string out;
-  for (unsigned char c : s) {
-    if (c == '\n')
-      out += "\\n";
-    else if (c == '\r')
-      out += "\\r";
-    else if (c == '\t')
-      out += "\\t";
-    else if (c < 0x20 || c == 0x7f) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += buf;
-    } else {
-      out += char(c);
-    }
-  }
-  return out;
-}
-}  // namespace
-
 ScenarioError::ScenarioError(const std::string& file, const std::string& path, const std::string& expected)
-    : std::runtime_error(oneLine(file + ": " + path + ": expected " + expected)), file_(file), path_(path) {}
+    : std::runtime_error(escapeControl(file + ": " + path + ": expected " + expected)), file_(file), path_(path) {}
 
 namespace {
 /// Parses JSON text, reporting the byte and line of a syntax error and the path of a number that

@@ -24,6 +24,7 @@
 #include "replay/player.h"
 #include "replay/progress.h"
 #include "replay/scenario_files.h"
+#include "sim/scenario/json_bounds.h"
 #include "viewer/offscreen/osmesa_context.h"
 #include "viewer/render/scene.h"
 
@@ -251,23 +252,10 @@ double median(std::vector<double> v) {
 }
 
 /// An argument quoted in a message: control characters escaped, at most 60 characters.
-std::string shown(const std::string& s) {
-  std::string out;
-  for (size_t i = 0; i < s.size() && i < 60; ++i) {
-    const unsigned char c = static_cast<unsigned char>(s[i]);
-    if (c < 0x20 || c == 0x7f) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += buf;
-    } else {
-      out += char(c);
-    }
-  }
-  return s.size() > 60 ? out + "..." : out;
-}
+std::string shown(const std::string& s) { return echoText(s); }
 
 int fail(int code, const std::string& message) {
-  std::fprintf(stderr, "simgrass render: %s\n", message.c_str());
+  printError("simgrass render: %s", message.c_str());
   return code;
 }
 
