@@ -389,6 +389,33 @@ TEST(DiffCli, BadInputIsOneLine) {
   }
 }
 
+TEST(DiffCli, ACutOffRecordingAgreeingInFullExitsThreeAsReplayDoes) {
+  // A recording killed mid-run (here: its last 40 bytes cut, inside the END chunk or the last
+  // tick) is used up to its last complete chunk; agreeing there is not a clean exit 0.
+  TempDir dir;
+  const std::string a = record(dir, "a.sgr");
+  std::vector<uint8_t> bytes = readBytes(a);
+  bytes.resize(bytes.size() - 40);
+  const std::string cut = dir.file("cut.sgr");
+  writeBytes(cut, bytes);
+  const CliResult replay = runCli("replay " + quote(cut));
+  ASSERT_EQ(replay.exitCode, 3) << replay.describe();
+  const CliResult diff = runCli("diff " + quote(a) + " " + quote(cut) + " --json");
+  EXPECT_EQ(diff.exitCode, 3) << diff.describe();
+  EXPECT_TRUE(isOneLine(diff.err)) << diff.err;
+  EXPECT_NE(diff.err.find("cut.sgr: byte"), std::string::npos) << diff.err;
+  const json j = parseJson(diff);
+  EXPECT_EQ(j["b"]["truncated"], true);
+  EXPECT_EQ(j["a"]["truncated"], false);
+  EXPECT_EQ(j["identical"], true);
+  const CliResult compare = runCli("compare " + quote(cut) + " --variant threads=2 --json");
+  EXPECT_EQ(compare.exitCode, 3) << compare.describe();
+  EXPECT_EQ(parseJson(compare)["truncated"], true);
+  // A real divergence still wins over the cut: exit 1.
+  const std::string k2 = record(dir, "k2.sgr", "interp=2");
+  EXPECT_EQ(runCli("diff " + quote(k2) + " " + quote(cut)).exitCode, 1);
+}
+
 TEST(CompareCli, BroadPhasesAndThreadsAreIdentical) {
   TempDir dir;
   const std::string run = record(dir, "run.sgr");

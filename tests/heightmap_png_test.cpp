@@ -203,6 +203,27 @@ TEST(HeightmapPng, TruncatedFilesAreRefused) {
   expectRefused(Bytes(whole.begin(), whole.begin() + 33), "a readable PNG (");
 }
 
+TEST(HeightmapPng, APaletteInAGrayImageOrBytesAfterIendAreRefused) {
+  // The PNG spec forbids PLTE in a grayscale image; spng decodes it anyway.
+  Png palette = gray8(4, 3);
+  palette.before.push_back(Bytes{'P', 'L', 'T', 'E', 0, 0, 0, 255, 255, 255});
+  expectRefused(palette.bytes(), "a grayscale PNG without a palette (PLTE chunk at byte 33)");
+  // Bytes glued after IEND: a second image, or another file, that the decoder never sees.
+  Bytes glued = gray8(4, 3).bytes();
+  const size_t end = glued.size();
+  glued.push_back(0);
+  expectRefused(glued, "the end of the PNG file after its IEND chunk (byte " + std::to_string(end) + " of " +
+                           std::to_string(end + 1) + ")");
+  Bytes twice = gray8(4, 3).bytes();
+  const Bytes again = gray8(4, 3).bytes();
+  twice.insert(twice.end(), again.begin(), again.end());
+  expectRefused(twice, "after its IEND chunk");
+  // The plain file still decodes.
+  Heightmap h;
+  std::string error;
+  EXPECT_TRUE(decodeHeightmapPng(gray8(4, 3).bytes(), &h, &error)) << error;
+}
+
 TEST(HeightmapPng, OtherDepthsAndColourTypesAreRefusedBeforeDecoding) {
   const struct {
     uint8_t depth, colour;

@@ -48,6 +48,7 @@ bool reader(const std::string& path, std::vector<uint8_t>* bytes, std::string* e
     std::map<std::string, std::vector<uint8_t>> f;
     f["wide.png"] = flatPng(4097, 2);
     f["big.png"] = flatPng(2048, 2048);
+    f["hill.png"] = flatPng(8, 8);
     f["claims16384.png"] = pngHeaderOnly(16384, 16384);
     return f;
   }();
@@ -348,10 +349,37 @@ TEST(ScenarioDerived, AValueWhoseDerivedConstantOverflowsIsNamedAsSuch) {
                           "whose 1/mass is within the fx32 range"));
   EXPECT_TRUE(throwsError(build(R"({"particles": {"mass": 6e8}})"), "$.particles.mass",
                           "expected a value within the fx32 range"));
-  // A spacing so wide that a gust takes 2^40 ticks to cross the field: the message names the
-  // spacing as well as the travel speed it is reported at.
-  EXPECT_TRUE(throwsError(build(R"({"scalar": "double", "field": {"spacing": 1e13}})"), "$.wind.travelSpeed",
+  // A spacing so wide that a gust takes 2^40 ticks to cross the field is reported at the spacing;
+  // a gust so slow that it does is reported at the travel speed.
+  EXPECT_TRUE(throwsError(build(R"({"scalar": "double", "field": {"spacing": 1e13}})"), "$.field.spacing",
                           "a gust crossing of the field (rows x field.spacing"));
+  EXPECT_TRUE(throwsError(build(R"({"scalar": "double", "wind": {"travelSpeed": 1e-12}})"), "$.wind.travelSpeed",
+                          "a gust crossing of the field"));
+}
+
+TEST(ScenarioDerived, AReachOutOfRangeIsReportedAtItsLargestTerm) {
+  // A blade top is terrain height + constraintLength + scaleY: the key named is the one that is
+  // out of scale, not always the terrain's.
+  auto build = [](const std::string& text) { return [text] { makeWorld(parse(text)); }; };
+  EXPECT_TRUE(throwsError(build(R"({"scalar": "double", "particles": {"constraintLength": 1e15}})"),
+                          "$.particles.constraintLength", "a blade top"));
+  EXPECT_TRUE(
+      throwsError(build(R"({"scalar": "double", "field": {"scaleY": 1e15}})"), "$.field.scaleY", "a blade top"));
+  EXPECT_TRUE(throwsError(build(R"({"scalar": "double", "terrain": {"type": "flat", "height": 1e15}})"),
+                          "$.terrain.height", "a blade top"));
+  // A field or heightmap extent: the centre when it is the larger term, else what sets the size.
+  EXPECT_TRUE(
+      throwsError(build(R"({"scalar": "fx16", "field": {"center": [8191, 0]}})"), "$.field.center[0]", "a field"));
+  EXPECT_TRUE(throwsError(build(R"({"scalar": "fx16", "field": {"spacing": 10000}})"), "$.field.spacing", "a field"));
+  EXPECT_TRUE(throwsError(build(R"({"scalar": "fx16", "field": {"spacing": 1000}})"), "$.field.patchesX", "a field"));
+  EXPECT_TRUE(throwsError(build(R"({"scalar": "fx16", "field": {"patchesX": 200000, "patchesZ": 2}})"),
+                          "$.field.patchesX", "a field"));
+  EXPECT_TRUE(throwsError(build(R"({"scalar": "fx16", "terrain": {"type": "heightmap", "file": "hill.png",
+                                    "center": [8191, 8191]}})"),
+                          "$.terrain.center[0]", "a heightmap"));
+  EXPECT_TRUE(throwsError(build(R"({"scalar": "fx16", "terrain": {"type": "heightmap", "file": "hill.png",
+                                    "cellSize": 5000}})"),
+                          "$.terrain.cellSize", "a heightmap"));
 }
 
 // ---- 7. heightmap size cap and memory estimate ------------------------------------------------

@@ -170,11 +170,14 @@ TEST(OutputTargets, SweepDoesNotWriteAPlotOverTheScenariosHeightmap) {
   fs::create_directory(dir.path() / "o3");
   const std::string png = dir.write("o3/h-body.png", readFile(test::sourcePath("scenarios/hills.png")));
   const std::string scenario = scenarioReading(dir, "o3/h-body.png", "h");
+  // --seconds 600: the plots' names are checked before the run, so this is refused at once (it
+  // was refused only after the whole sweep ran, when the plot was about to be written).
   const CliResult r =
       runCli("sweep --scenarios " + quote(scenario) +
-             " --seconds 0.1 --scalars fx32 --k 1 --dt 1/60 --lod off --repeats 1 --out " + quote(dir.file("o3")));
+             " --seconds 600 --scalars fx32 --k 1 --dt 1/60 --lod off --repeats 1 --out " + quote(dir.file("o3")));
   expectRefusedOverwrite(r);
   EXPECT_EQ(readFile(png), readFile(test::sourcePath("scenarios/hills.png")));
+  EXPECT_FALSE(fs::exists(dir.path() / "o3" / "sweep.csv"));
 }
 
 TEST(OutputTargets, RecordDoesNotWriteOverAMeshTheScenarioNames) {

@@ -95,6 +95,13 @@ std::vector<Chunk> withoutHashes(int64_t endTick, bool faulted = false) {
   return out;
 }
 
+/// tiny.sgr with its HEAD payload replaced by `head`.
+std::vector<uint8_t> withHead(const std::vector<uint8_t>& head) {
+  std::vector<Chunk> chunks = chunksOf(readBytes(tinyRecording()));
+  chunks[0].payload = head;
+  return assemble(chunks);
+}
+
 /// The last tick the INPT chunks of tiny.sgr name.
 int64_t lastInputTick() { return sgr::parseRecording(readBytes(tinyRecording()), "tiny.sgr").inputs.back().tick; }
 
@@ -540,6 +547,11 @@ TEST(RecordingLimits, AReplayThatFaultedBeforeItsTargetWritesNoState) {
       EXPECT_TRUE(contains(r.err, "no state written to " + state)) << r.describe();
       EXPECT_FALSE(fs::exists(state)) << "a state was written for a replay that faulted" << r.describe();
     }
+    // The fault line names the recording, with or without a state to write.
+    const CliResult r = runCli("replay " + quote(recording) + how);
+    EXPECT_EQ(r.exitCode, kExitMismatch) << r.describe();
+    EXPECT_TRUE(isOneLine(r.err)) << r.describe();
+    EXPECT_TRUE(contains(r.err, "simgrass replay: " + recording + ": ")) << r.describe();
   }
 }
 
@@ -816,6 +828,29 @@ TEST(RecordingLimits, AnOptionValueIsEchoedShortened) {
 TEST(RecordingLimits, EscapeControlKeepsTextOnOneLine) {
   EXPECT_EQ(escapeControl("a\nb\rc\td\x01\x7f"), "a\\nb\\rc\\td\\x01\\x7f");
   EXPECT_EQ(escapeControl("caf\xc3\xa9"), "caf\xc3\xa9");  // UTF-8 passes through
+}
+
+// A later format that used the reserved bytes was read as this one; a second file of the same
+// name was ignored, so the recording did not say what it replays.
+TEST(RecordingHead, ReservedBytesMustBeZeroAndEmbeddedNamesUnique) {
+  const uint64_t head = payloadOffset(chunksOf(readBytes(tinyRecording())), 0);
+  for (size_t byte : {1, 2, 3}) {
+    std::vector<uint8_t> payload = sgr::encodeHead(tinyHeader());
+    payload[byte] = 0x01;
+    const sgr::RecordingError e = parseError(withHead(payload));
+    EXPECT_EQ(e.offset(), head + 1) << e.what();
+    EXPECT_TRUE(contains(e.what(), "expected reserved bytes 0")) << e.what();
+  }
+  sgr::Header h = tinyHeader();
+  h.files = {{"hill.png", {1, 2, 3}}, {"hill.png", {4, 5}}};
+  const sgr::RecordingError e = parseError(withHead(sgr::encodeHead(h)));
+  EXPECT_TRUE(contains(e.what(), "expected each embedded file name once")) << e.what();
+  EXPECT_GT(e.offset(), head);
+  // record refuses beforehand what replay would refuse.
+  EXPECT_TRUE(contains(sgr::headerProblem(h), "each embedded file name once (hill.png is given twice)"));
+  h.files[1].name = "other.png";
+  EXPECT_EQ(sgr::headerProblem(h), "");
+  EXPECT_TRUE(contains(parseError(withHead(sgr::encodeHead(h))).what(), "(no error)"));
 }
 
 }  // namespace

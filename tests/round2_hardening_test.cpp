@@ -15,14 +15,6 @@
 #include "tests/cli_support.h"
 #include "tests/test_support.h"
 
-#if defined(__SANITIZE_ADDRESS__)
-#define SIMGRASS_TEST_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define SIMGRASS_TEST_ASAN 1
-#endif
-#endif
-
 namespace sg {
 namespace {
 

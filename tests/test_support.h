@@ -1,6 +1,16 @@
 // Shared helpers for the test suites.
 #pragma once
 
+/// SIMGRASS_TEST_ASAN: defined under AddressSanitizer (GCC or Clang), whose shadow memory does
+/// not mix with an address-space limit (ulimit -v): tests that set one skip themselves.
+#if defined(__SANITIZE_ADDRESS__)
+#define SIMGRASS_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define SIMGRASS_TEST_ASAN 1
+#endif
+#endif
+
 #include <cstdlib>
 #include <string>
 

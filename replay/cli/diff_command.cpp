@@ -51,6 +51,7 @@ struct Side {
                         {"scenario", run->player().scenario().name},
                         {"variant", settings()},
                         {"lastTick", rec->lastTick()},
+                        {"truncated", rec->truncated},
                         {"ticksPerStep", ticksPerStep},
                         {"verified", verified()},
                         {"hashesChecked", hashesChecked}};
@@ -227,10 +228,10 @@ int diff(const DiffOptions& o) {
     out["series"] = std::move(s);
     std::printf("%s\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   } else {
-    std::printf("A           %s: %s, %s; %s\n", o.a.c_str(), a.run->player().scenario().name.c_str(),
-                a.settings().c_str(), a.verifiedText().c_str());
-    std::printf("B           %s: %s, %s; %s\n", o.b.c_str(), b.run->player().scenario().name.c_str(),
-                b.settings().c_str(), b.verifiedText().c_str());
+    std::printf("A           %s: %s, %s; %s\n", escapeControl(o.a).c_str(),
+                escapeControl(a.run->player().scenario().name).c_str(), a.settings().c_str(), a.verifiedText().c_str());
+    std::printf("B           %s: %s, %s; %s\n", escapeControl(o.b).c_str(),
+                escapeControl(b.run->player().scenario().name).c_str(), b.settings().c_str(), b.verifiedText().c_str());
     std::string timeBase;
     if (b.ticksPerStep > 1) timeBase = "; B takes " + std::to_string(b.ticksPerStep) + " ticks per tick of A";
     if (a.ticksPerStep > 1) timeBase = "; every " + std::to_string(a.ticksPerStep) + " ticks of A, one of B";
@@ -250,11 +251,14 @@ int diff(const DiffOptions& o) {
                 shortNumber(summary.bodyPosMax).c_str(), shortNumber(summary.bodyAngleMax).c_str(),
                 summary.contactDeltaMax);
     if (!o.heatmap.empty())
-      std::printf("heat map    %s\n",
-                  heatTaken ? (o.heatmap + " (tick " + std::to_string(a.heat.tick) + ")").c_str() : heatError.c_str());
-    if (!o.csv.empty()) std::printf("csv         %s (%zu rows)\n", o.csv.c_str(), series.size());
+      std::printf(
+          "heat map    %s\n",
+          escapeControl(heatTaken ? o.heatmap + " (tick " + std::to_string(a.heat.tick) + ")" : heatError).c_str());
+    if (!o.csv.empty()) std::printf("csv         %s (%zu rows)\n", escapeControl(o.csv).c_str(), series.size());
   }
   if (code == kExitOk && firstDivergent >= 0) code = kExitMismatch;
+  // As `replay`: a cut-off recording compared in full is still not a clean agreement.
+  if (code == kExitOk && (a.rec->truncated || b.rec->truncated)) code = kExitTruncated;
   return code;
 }
 }  // namespace

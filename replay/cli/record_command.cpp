@@ -138,8 +138,8 @@ int record(const RecordOptions& o) {
     if (!last.ok) j["error"] = last.error.message();
     std::printf("%s\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   } else {
-    std::printf("recorded   %" PRId64 " ticks of %s (%s) to %s\n", ran, scenario.name.c_str(),
-                VariantSettings::resolvedFrom(scenario).describe().c_str(), o.output.c_str());
+    std::printf("recorded   %" PRId64 " ticks of %s (%s) to %s\n", ran, escapeControl(scenario.name).c_str(),
+                VariantSettings::resolvedFrom(scenario).describe().c_str(), escapeControl(o.output).c_str());
     std::printf("file       %.1f KiB; a hash every %u tick%s, a snapshot every %u\n",
                 double(recorder->bytesWritten()) / 1024.0, settings.checkEvery, settings.checkEvery == 1 ? "" : "s",
                 settings.snapshotEvery);

@@ -66,9 +66,10 @@ int replay(const ReplayOptions& o) {
     if (o.json) {
       std::printf("%s\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
     } else {
-      std::printf("recording  %s (%s)\n", o.file.c_str(), rec->end ? "complete" : "cut off before END");
-      std::printf("scenario   %s, %s\n", rec->header.scenarioSource.c_str(), rec->header.variant.c_str());
-      std::printf("built by   %s\n", rec->header.buildId.c_str());
+      std::printf("recording  %s (%s)\n", escapeControl(o.file).c_str(), rec->end ? "complete" : "cut off before END");
+      std::printf("scenario   %s, %s\n", escapeControl(rec->header.scenarioSource).c_str(),
+                  escapeControl(rec->header.variant).c_str());
+      std::printf("built by   %s\n", escapeControl(rec->header.buildId).c_str());
       std::printf("ticks      %" PRId64 " to %" PRId64 "; %zu input chunk%s, %zu hash%s, %zu snapshot%s\n",
                   rec->header.startTick, rec->lastTick(), rec->inputs.size(), rec->inputs.size() == 1 ? "" : "s",
                   rec->checks.size(), rec->checks.size() == 1 ? "" : "es", rec->snapshots.size(),
@@ -193,7 +194,7 @@ int replay(const ReplayOptions& o) {
                 inFaultedStep ? " (in the step that faulted, as recorded)"
                 : expected    ? (*expected == hash ? " (matches the recording)" : " (DIFFERS from the recording)")
                               : "");
-    if (!o.exportState.empty() && !faulted) std::printf("state written to %s\n", o.exportState.c_str());
+    if (!o.exportState.empty() && !faulted) std::printf("state written to %s\n", escapeControl(o.exportState).c_str());
   }
   if (code == kExitOk && rec->truncated) code = kExitTruncated;
   return code;

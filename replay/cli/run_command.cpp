@@ -120,7 +120,8 @@ int runScenario(const RunOptions& o) {
     if (!failure.ok) j["error"] = failure.error.message();
     std::printf("%s\n", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   } else {
-    std::printf("scenario   %s (%s)\n", scenario.name.c_str(), scenario.sourceName.c_str());
+    std::printf("scenario   %s (%s)\n", escapeControl(scenario.name).c_str(),
+                escapeControl(scenario.sourceName).c_str());
     std::printf("scalar     %s, interpolation k=%d, %d thread%s, %s particle kernel\n", scalarName(scenario.scalar),
                 counts.interpolation, counts.threads, counts.threads == 1 ? "" : "s",
                 particleKernelName(world->particleKernel()));

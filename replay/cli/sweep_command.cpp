@@ -446,6 +446,17 @@ int sweep(const SweepOptions& o) {
   };
   for (const char* name : {"sweep.csv", "sweep.json"})
     if (overwritesScenario((fs::path(o.out) / name).string())) return kExitBadInput;
+  // The plots' names too, before the run (not after an hour of it): three per scenario, named by
+  // its slug (numbered when two scenarios share one).
+  static constexpr const char* kPlotSuffixes[] = {"tip-rms", "tip-max", "body"};
+  std::vector<std::string> plotBase;
+  for (size_t s = 0; s < scenarios.size(); ++s) {
+    std::string base = slug(scenarios[s].name);
+    if (std::find(plotBase.begin(), plotBase.end(), base) != plotBase.end()) base += "-" + std::to_string(s + 1);
+    plotBase.push_back(base);
+    for (const char* suffix : kPlotSuffixes)
+      if (overwritesScenario((fs::path(o.out) / (base + "-" + suffix + ".png")).string())) return kExitBadInput;
+  }
 
   std::vector<SweepRow> rows;
   for (size_t s = 0; s < scenarios.size(); ++s)
@@ -554,14 +565,11 @@ int sweep(const SweepOptions& o) {
 
   // The plots: three per scenario.
   std::vector<std::string> pngs;
-  std::vector<std::string> usedSlugs;
   for (size_t s = 0; s < scenarios.size(); ++s) {
     std::vector<const SweepRow*> mine;
     for (const SweepRow& r : rows)
       if (r.scenario == s) mine.push_back(&r);
-    std::string base = slug(scenarios[s].name);
-    if (std::find(usedSlugs.begin(), usedSlugs.end(), base) != usedSlugs.end()) base += "-" + std::to_string(s + 1);
-    usedSlugs.push_back(base);
+    const std::string& base = plotBase[s];
     struct Kind {
       const char* suffix;
       const char* what;
@@ -570,14 +578,15 @@ int sweep(const SweepOptions& o) {
       bool SweepRow::*front;
     };
     const Kind kinds[] = {
-        {"tip-rms", "tip RMS error", "m", [](const SweepRow& r) { return r.summary.tipRms(); }, &SweepRow::pareto},
-        {"tip-max", "tip max error", "m", [](const SweepRow& r) { return r.summary.tipMax; }, &SweepRow::paretoTipMax},
-        {"body", "body position max error", "m", [](const SweepRow& r) { return r.summary.bodyPosMax; },
+        {kPlotSuffixes[0], "tip RMS error", "m", [](const SweepRow& r) { return r.summary.tipRms(); },
+         &SweepRow::pareto},
+        {kPlotSuffixes[1], "tip max error", "m", [](const SweepRow& r) { return r.summary.tipMax; },
+         &SweepRow::paretoTipMax},
+        {kPlotSuffixes[2], "body position max error", "m", [](const SweepRow& r) { return r.summary.bodyPosMax; },
          &SweepRow::paretoBody},
     };
     for (const Kind& k : kinds) {
       const std::string path = (fs::path(o.out) / (base + "-" + k.suffix + ".png")).string();
-      if (overwritesScenario(path)) return kExitBadInput;
       std::string error;
       if (!plot::writePng(
               path,
@@ -611,8 +620,8 @@ int sweep(const SweepOptions& o) {
         o.repeats == 1 ? "" : "s", o.threads, o.threads == 1 ? "" : "s");
     for (size_t s = 0; s < scenarios.size(); ++s) {
       const SweepScenario& sc = scenarios[s];
-      std::printf("\n%s (%s): %" PRId64 " patches, %" PRId64 " bodies\n", sc.name.c_str(), sc.file.c_str(), sc.patches,
-                  sc.bodies);
+      std::printf("\n%s (%s): %" PRId64 " patches, %" PRId64 " bodies\n", escapeControl(sc.name).c_str(),
+                  escapeControl(sc.file).c_str(), sc.patches, sc.bodies);
       std::printf("%-28s %10s %12s %11s %11s %11s %9s  %s\n", "variant", "ms/tick", "ms/sim s", "tip rms m",
                   "tip max m", "body pos m", "diverges", "status");
       for (const SweepRow& r : rows) {
@@ -629,8 +638,8 @@ int sweep(const SweepOptions& o) {
                     r.pareto ? "  * pareto" : "");
       }
     }
-    std::printf("\nwrote      %s, %s and %zu plots in %s\n", csvPath.c_str(), jsonPath.c_str(), pngs.size(),
-                o.out.c_str());
+    std::printf("\nwrote      %s, %s and %zu plots in %s\n", escapeControl(csvPath).c_str(),
+                escapeControl(jsonPath).c_str(), pngs.size(), escapeControl(o.out).c_str());
     std::printf(
         "* pareto: no other variant of the scenario is both cheaper (ms per simulated second) and more "
         "accurate (tip RMS error).\n");

@@ -195,8 +195,10 @@ void parseHead(Recording& r, Cursor& c) {
   const uint8_t scalar = c.get<uint8_t>("the scalar type");
   if (scalar > uint8_t(ScalarKind::Double)) c.fail(scalarAt, "a scalar type 0..3, got " + std::to_string(scalar));
   h.scalar = ScalarKind(scalar);
-  c.get<uint8_t>("reserved");
-  c.get<uint16_t>("reserved");
+  // Reserved bytes are 0: a later format that uses them must not be read as this one.
+  const uint64_t reservedAt = c.offset();
+  if (c.get<uint8_t>("reserved") != 0 || c.get<uint16_t>("reserved") != 0)
+    c.fail(reservedAt, "reserved bytes 0 (3 bytes after the scalar type)");
   h.checkEvery = c.get<uint32_t>("the check interval");
   h.snapshotEvery = c.get<uint32_t>("the snapshot interval");
   h.scenarioHash = c.get<uint64_t>("the scenario hash");
@@ -218,7 +220,12 @@ void parseHead(Recording& r, Cursor& c) {
     c.fail(countAt, "at most " + std::to_string(kMaxEmbeddedFiles) + " embedded files, got " + std::to_string(files));
   for (uint32_t f = 0; f < files; ++f) {
     EmbeddedFile e;
+    const uint64_t nameAt = c.offset();
     e.name = c.string("an embedded file name", kMaxShortString);
+    // Names are looked up by the scenario's file names: one name, one file (a second would be
+    // ignored, so the recording would not say what it replays).
+    for (const EmbeddedFile& before : h.files)
+      if (before.name == e.name) c.fail(nameAt, "each embedded file name once (this one is given twice)");
     e.bytes = c.bytes("an embedded file");
     h.files.push_back(std::move(e));
   }

@@ -52,8 +52,11 @@ std::string headerProblem(const Header& h) {
     return "at most " + std::to_string(kMaxEmbeddedFiles) + " embedded files, got " + std::to_string(h.files.size());
   uint64_t total =
       36 + 4 + h.variant.size() + 4 + h.scenarioSource.size() + 4 + h.scenarioText.size() + 4 + 4 + h.buildId.size();
-  for (const EmbeddedFile& f : h.files) {
+  for (size_t i = 0; i < h.files.size(); ++i) {
+    const EmbeddedFile& f = h.files[i];
     if (f.name.size() > kMaxShortString) return tooLong("an embedded file name", kMaxShortString, f.name.size());
+    for (size_t k = 0; k < i; ++k)
+      if (h.files[k].name == f.name) return "each embedded file name once (" + f.name + " is given twice)";
     total += 4 + f.name.size() + 4 + f.bytes.size();
   }
   if (total > kMaxHeadPayload)

@@ -65,10 +65,13 @@ ScenarioConstants deriveConstants(const Scenario& s) {
   const Rational rowSpacing = ok(mul(f.spacing, Rational::integer(k)), "$.field.spacing");
   const Rational ticksPerRow =
       ok(div(rowSpacing, ok(mul(s.wind.travelSpeed, s.timeStep), "$.wind.travelSpeed")), "$.wind.travelSpeed");
+  // Too long a crossing is a too-slow gust, unless the spacing is over a metre (blades are
+  // centimetres apart): then the spacing is the value to change (the same rule as the field reach).
+  const char* crossingKey = compare(f.spacing, Rational{1, 1}) > 0 ? "$.field.spacing" : "$.wind.travelSpeed";
   c.rowDelayTicks.resize(size_t(c.particlesZ));
   for (int64_t r = 0; r < c.particlesZ; ++r)
     c.rowDelayTicks[size_t(r)] =
-        ok.ticks(mul(ticksPerRow, Rational::integer(r)), "$.wind.travelSpeed",
+        ok.ticks(mul(ticksPerRow, Rational::integer(r)), crossingKey,
                  "a gust crossing of the field (rows x field.spacing x interpolation / (travelSpeed x timeStep))");
 
   if (!s.terrain.flat) {

@@ -15,21 +15,54 @@ size_t cutPoint(std::string_view s, size_t n) {
   return n;
 }
 
+/// The length of the valid UTF-8 sequence at s[i] (2 to 4), or 0 when the bytes there are not
+/// one (a stray continuation byte, a cut sequence, an overlong form, a surrogate, > U+10FFFF).
+size_t utf8SequenceAt(std::string_view s, size_t i) {
+  const auto b = [&](size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char lead = b(i);
+  const size_t n = lead >= 0xF0 ? 4 : lead >= 0xE0 ? 3 : lead >= 0xC2 ? 2 : 0;
+  if (n == 0 || lead > 0xF4 || i + n > s.size()) return 0;
+  for (size_t k = 1; k < n; ++k)
+    if ((b(i + k) & 0xC0) != 0x80) return 0;
+  if (n == 3 && lead == 0xE0 && b(i + 1) < 0xA0) return 0;   // overlong
+  if (n == 3 && lead == 0xED && b(i + 1) >= 0xA0) return 0;  // a UTF-16 surrogate
+  if (n == 4 && lead == 0xF0 && b(i + 1) < 0x90) return 0;   // overlong
+  if (n == 4 && lead == 0xF4 && b(i + 1) >= 0x90) return 0;  // beyond U+10FFFF
+  return n;
+}
+
+void appendByte(std::string& out, unsigned char c) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "\\x%02x", c);
+  out += buf;
+}
+
+// Escapes what a terminal or a log would act on or mangle: C0 controls and DEL, the C1 controls
+// U+0080..U+009F (U+009B is a CSI on some terminals), and bytes that are not valid UTF-8.
 void appendEscaped(std::string& out, std::string_view s) {
-  for (unsigned char c : s) {
-    if (c == '\n')
+  for (size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    size_t n = 1;  // bytes consumed
+    if (c == '\n') {
       out += "\\n";
-    else if (c == '\r')
+    } else if (c == '\r') {
       out += "\\r";
-    else if (c == '\t')
+    } else if (c == '\t') {
       out += "\\t";
-    else if (c < 0x20 || c == 0x7f) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += buf;
-    } else {
+    } else if (c < 0x20 || c == 0x7f) {
+      appendByte(out, c);
+    } else if (c < 0x80) {
       out += char(c);
+    } else if ((n = utf8SequenceAt(s, i)) == 0) {
+      appendByte(out, c);  // not UTF-8: this byte alone, then resynchronise on the next
+      n = 1;
+    } else if (n == 2 && c == 0xC2 && static_cast<unsigned char>(s[i + 1]) < 0xA0) {
+      appendByte(out, c);  // a C1 control
+      appendByte(out, static_cast<unsigned char>(s[i + 1]));
+    } else {
+      out.append(s.substr(i, n));
     }
+    i += n;
   }
 }
 

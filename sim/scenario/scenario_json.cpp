@@ -614,7 +614,7 @@ json loadJson(const std::string& text, const std::string& sourceName, std::map<s
   }
   if (!wellFormed && collector.numberOverflow)
     throw ScenarioError(sourceName, collector.errorPath,
-                        "a number from 1e-36 to below 1e36 in magnitude, got " + collector.errorToken);
+                        "a number from 1e-36 to below 1e36 in magnitude, got " + echoText(collector.errorToken));
   json root;
   try {
     root = json::parse(text);
@@ -622,7 +622,8 @@ json loadJson(const std::string& text, const std::string& sourceName, std::map<s
     // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: ..."
     std::string what = e.what();
     const size_t colon = what.find(": ", what.find("error"));
-    std::string detail = colon == std::string::npos ? what : what.substr(colon + 2);
+    // The detail ends with the token last read, which may be a whole unterminated string: cut it.
+    const std::string detail = echoText(colon == std::string::npos ? what : what.substr(colon + 2), 2 * kEchoChars);
     const size_t byte = collector.errorByte;
     throw ScenarioError(sourceName, "byte " + std::to_string(byte) + " (" + lineColumn(text, byte ? byte - 1 : 0) + ")",
                         "valid JSON (" + detail + ")");

@@ -147,13 +147,41 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
                                 metres(reach));
       }
     };
-    check(reachX, "$.field.patchesX", "a field");
-    check(reachZ, "$.field.patchesZ", "a field");
-    check(ground + tall, s.terrain.flat ? "$.terrain.height" : "$.terrain.maxHeight", "a terrain height");
+    // A reach is a sum of terms; the fault is reported at the largest term's key, the one to change.
+    auto largest = [](std::initializer_list<std::pair<double, const char*>> terms) {
+      const char* path = terms.begin()->second;
+      double most = -1;
+      for (const auto& [value, key] : terms)
+        if (!(value <= most)) most = value, path = key;  // NaN/inf terms win
+      return path;
+    };
+    // The field's half extent is spacing x patches: blame the spacing when even a one-patch field
+    // at that spacing would not fit, else the patch count along the axis that does not fit.
+    const bool spacingAlone = std::fabs(sp) * (1 + 2 * k) / 2 > limit;
+    const char* extentX = spacingAlone ? "$.field.spacing" : "$.field.patchesX";
+    const char* extentZ = spacingAlone ? "$.field.spacing" : "$.field.patchesZ";
+    check(reachX,
+          largest({{reachX - std::fabs(d(s.field.centerX)), extentX},
+                   {std::fabs(d(s.field.centerX)), "$.field.center[0]"}}),
+          "a field (|center| + spacing x patches / 2)");
+    check(reachZ,
+          largest({{reachZ - std::fabs(d(s.field.centerZ)), extentZ},
+                   {std::fabs(d(s.field.centerZ)), "$.field.center[1]"}}),
+          "a field (|center| + spacing x patches / 2)");
+    check(ground + tall,
+          largest({{ground, s.terrain.flat ? "$.terrain.height" : "$.terrain.maxHeight"},
+                   {std::fabs(d(s.particles.constraintLength)), "$.particles.constraintLength"},
+                   {std::fabs(d(s.field.scaleY)), "$.field.scaleY"}}),
+          "a blade top (terrain height + constraintLength + scaleY)");
     if (!s.terrain.flat) {
       const double cs = d(s.terrain.cellSize);
-      check(std::fabs(d(s.terrain.centerX)) + cs * s.terrain.heightmap.width / 2, "$.terrain.cellSize", "a heightmap");
-      check(std::fabs(d(s.terrain.centerZ)) + cs * s.terrain.heightmap.height / 2, "$.terrain.cellSize", "a heightmap");
+      const double halfW = cs * s.terrain.heightmap.width / 2, halfH = cs * s.terrain.heightmap.height / 2;
+      check(std::fabs(d(s.terrain.centerX)) + halfW,
+            largest({{halfW, "$.terrain.cellSize"}, {std::fabs(d(s.terrain.centerX)), "$.terrain.center[0]"}}),
+            "a heightmap (|center| + cellSize x samples / 2)");
+      check(std::fabs(d(s.terrain.centerZ)) + halfH,
+            largest({{halfH, "$.terrain.cellSize"}, {std::fabs(d(s.terrain.centerZ)), "$.terrain.center[1]"}}),
+            "a heightmap (|center| + cellSize x samples / 2)");
     }
     for (size_t i = 0; i < s.wind.schedule.size(); ++i)
       for (int c = 0; c < 3; ++c)

@@ -4,6 +4,8 @@
 
 #include <cstring>
 #include <memory>
+#include <string>
+#include <string_view>
 
 namespace {
 
@@ -42,6 +44,27 @@ const char* colourTypeName(uint8_t type) {
     default:
       return "unknown colour type";
   }
+}
+
+/// Walks the chunk frames of a PNG that spng decoded (so every frame up to IEND is whole and its
+/// CRC checked): a PLTE chunk or bytes after IEND give the reason, else "".
+std::string chunkLayoutProblem(std::span<const uint8_t> bytes) {
+  size_t at = 8;  // after the signature
+  while (at + 12 <= bytes.size()) {
+    const uint32_t length = uint32_t(bytes[at]) << 24 | uint32_t(bytes[at + 1]) << 16 | uint32_t(bytes[at + 2]) << 8 |
+                            uint32_t(bytes[at + 3]);
+    const std::string_view type(reinterpret_cast<const char*>(bytes.data() + at + 4), 4);
+    if (type == "PLTE") return "a grayscale PNG without a palette (PLTE chunk at byte " + std::to_string(at) + ")";
+    const size_t next = at + 12 + size_t(length);
+    if (type == "IEND") {
+      if (next != bytes.size())
+        return "the end of the PNG file after its IEND chunk (byte " + std::to_string(next) + " of " +
+               std::to_string(bytes.size()) + ")";
+      return "";
+    }
+    at = next;
+  }
+  return "";  // spng found IEND, so this is not reached for a decoded file
 }
 
 }  // namespace
@@ -102,6 +125,12 @@ bool decodeHeightmapPng(std::span<const uint8_t> bytes, Heightmap* out, std::str
   if (!err) err = spng_decode_chunks(ctx.get());
   if (err) {
     *error = readable(err);
+    return false;
+  }
+  // What spng lets pass but the PNG spec forbids: a palette in a grayscale image (PNG 11.2.3) and
+  // anything after IEND (a file glued to another, or a second image the decoder never sees).
+  if (const std::string why = chunkLayoutProblem(bytes); !why.empty()) {
+    *error = why;
     return false;
   }
   out->width = int(ihdr.width);
