@@ -7,17 +7,6 @@
 namespace sg {
 namespace {
 
-template <class S>
-struct VelocityRow {
-  Vec3<S> rA, rB;  // contact point relative to the centres of mass
-  Vec3<S> normal, t1, t2;
-  S massN{}, massT1{}, massT2{};  // 1 / effective mass along each direction
-  S target{};                     // desired separating normal velocity
-  S friction{};
-  S impulseN{}, impulseT1{}, impulseT2{};  // accumulated
-  int32_t a = 0, b = kTerrainBody;
-};
-
 /// A unit vector orthogonal to n, chosen by a fixed rule (no trigonometry).
 template <class S>
 Vec3<S> tangentOf(const Vec3<S>& n) {
@@ -44,14 +33,14 @@ void applyImpulse(RigidBody<S>& body, const Vec3<S>& r, const Vec3<S>& impulse) 
 }
 
 template <class S>
-Vec3<S> relativeVelocity(const std::vector<RigidBody<S>>& bodies, const VelocityRow<S>& row) {
+Vec3<S> relativeVelocity(const std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row) {
   Vec3<S> v = velocityAt(bodies[size_t(row.a)], row.rA);
   if (row.b != kTerrainBody) v -= velocityAt(bodies[size_t(row.b)], row.rB);
   return v;
 }
 
 template <class S>
-void applyPair(std::vector<RigidBody<S>>& bodies, const VelocityRow<S>& row, const Vec3<S>& impulse) {
+void applyPair(std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row, const Vec3<S>& impulse) {
   applyImpulse(bodies[size_t(row.a)], row.rA, impulse);
   if (row.b != kTerrainBody) applyImpulse(bodies[size_t(row.b)], row.rB, Vec3<S>(-impulse));
 }
@@ -87,13 +76,13 @@ bool sameKey(const CachedImpulse<S>& x, const Contact<S>& y) {
 }
 
 template <class S>
-void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
-                            const SolverSettings<S>& settings, std::vector<CachedImpulse<S>>& cache) {
+void prepareContactRows(const std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
+                        std::vector<ContactRow<S>>& rows) {
   using std::sqrt;
-  std::vector<VelocityRow<S>> rows(contacts.size());
+  rows.assign(contacts.size(), ContactRow<S>{});
   for (size_t i = 0; i < contacts.size(); ++i) {
     const Contact<S>& c = contacts[i];
-    VelocityRow<S>& row = rows[i];
+    ContactRow<S>& row = rows[i];
     row.a = c.bodyA;
     row.b = c.bodyB;
     const RigidBody<S>& A = bodies[size_t(c.bodyA)];
@@ -104,23 +93,28 @@ void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector
     S kN = inverseMassAlong(A, row.rA, row.normal);
     S kT1 = inverseMassAlong(A, row.rA, row.t1);
     S kT2 = inverseMassAlong(A, row.rA, row.t2);
-    S restitution = A.restitution, friction = A.friction;
+    row.restitution = A.restitution;
+    row.friction = A.friction;
     if (c.bodyB != kTerrainBody) {
       const RigidBody<S>& B = bodies[size_t(c.bodyB)];
       row.rB = c.point - B.position;
       kN += inverseMassAlong(B, row.rB, row.normal);
       kT1 += inverseMassAlong(B, row.rB, row.t1);
       kT2 += inverseMassAlong(B, row.rB, row.t2);
-      restitution = A.restitution < B.restitution ? B.restitution : A.restitution;
-      friction = sqrt(A.friction * B.friction);
+      row.restitution = A.restitution < B.restitution ? B.restitution : A.restitution;
+      row.friction = sqrt(A.friction * B.friction);
     }
     row.massN = invertPositive(kN);
     row.massT1 = invertPositive(kT1);
     row.massT2 = invertPositive(kT2);
-    row.friction = friction;
-    const S vn = relativeVelocity(bodies, row).dot(row.normal);
-    row.target = vn < -settings.restitutionThreshold ? -restitution * vn : S(0);
+    row.approachVelocity = relativeVelocity(bodies, row).dot(row.normal);
   }
+}
+
+template <class S>
+void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
+                            std::vector<ContactRow<S>>& rows, const SolverSettings<S>& settings,
+                            std::vector<CachedImpulse<S>>& cache) {
   // Warm start, in two passes so every cached entry serves at most one contact: first the
   // contacts whose key (bodies and features) is unchanged, then the others by nearest point.
   std::vector<uint8_t> used(cache.size(), 0);
@@ -156,7 +150,7 @@ void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector
   }
   for (size_t i = 0; i < rows.size(); ++i) {
     if (match[i] == cache.size()) continue;
-    VelocityRow<S>& row = rows[i];
+    ContactRow<S>& row = rows[i];
     const CachedImpulse<S>& hit = cache[match[i]];
     row.impulseN = hit.normal;
     row.impulseT1 = hit.tangent1;
@@ -164,10 +158,10 @@ void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector
     applyPair(bodies, row, Vec3<S>(row.normal * row.impulseN + row.t1 * row.impulseT1 + row.t2 * row.impulseT2));
   }
   for (int it = 0; it < settings.velocityIterations; ++it) {
-    for (VelocityRow<S>& row : rows) {
-      // Normal: push apart until the separating velocity reaches the target; never pull.
+    for (ContactRow<S>& row : rows) {
+      // Normal: push apart until the bodies stop closing; never pull.
       const S vn = relativeVelocity(bodies, row).dot(row.normal);
-      S lambda = (row.target - vn) * row.massN;
+      S lambda = -vn * row.massN;
       const S total = maxS(row.impulseN + lambda, S(0));
       lambda = total - row.impulseN;
       row.impulseN = total;
@@ -186,6 +180,17 @@ void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector
       }
     }
   }
+  // Restitution: against the approach velocity measured before gravity and the solve, and only
+  // where the contact pushed (a contact that merely grazed bounces nothing).
+  for (ContactRow<S>& row : rows) {
+    if (!(row.approachVelocity < -settings.restitutionThreshold) || !(row.impulseN > S(0))) continue;
+    const S vn = relativeVelocity(bodies, row).dot(row.normal);
+    S lambda = -(vn + row.restitution * row.approachVelocity) * row.massN;
+    const S total = maxS(row.impulseN + lambda, S(0));
+    lambda = total - row.impulseN;
+    row.impulseN = total;
+    applyPair(bodies, row, Vec3<S>(row.normal * lambda));
+  }
   cache.clear();
   for (size_t i = 0; i < rows.size(); ++i)
     cache.push_back(CachedImpulse<S>{contacts[i].bodyA, contacts[i].bodyB, contacts[i].featureA, contacts[i].featureB,
@@ -194,13 +199,14 @@ void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector
 
 template <class S>
 void solveContactPositions(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
-                           const SolverSettings<S>& settings) {
+                           const std::vector<ContactRow<S>>& rows, S dt, const SolverSettings<S>& settings) {
   const size_t n = contacts.size();
   if (n == 0) return;
   std::vector<S> depth(n);
   std::vector<Vec3<S>> rA(n), rB(n);
   for (size_t i = 0; i < n; ++i) {
-    depth[i] = contacts[i].penetration;
+    const S separating = maxS(relativeVelocity(bodies, rows[i]).dot(rows[i].normal), S(0));
+    depth[i] = contacts[i].penetration - separating * dt;  // what integration will not remove
     rA[i] = contacts[i].point - bodies[size_t(contacts[i].bodyA)].position;
     if (contacts[i].bodyB != kTerrainBody) rB[i] = contacts[i].point - bodies[size_t(contacts[i].bodyB)].position;
   }
@@ -268,12 +274,15 @@ void solveContactPositions(std::vector<RigidBody<S>>& bodies, const std::vector<
   }
 }
 
-#define SG_INSTANTIATE(S)                                                                          \
-  template void sortContacts(std::vector<Contact<S>>&);                                            \
-  template void solveContactVelocities(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&, \
-                                       const SolverSettings<S>&, std::vector<CachedImpulse<S>>&);  \
-  template void solveContactPositions(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&,  \
-                                      const SolverSettings<S>&);
+#define SG_INSTANTIATE(S)                                                                            \
+  template void sortContacts(std::vector<Contact<S>>&);                                              \
+  template void prepareContactRows(const std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&, \
+                                   std::vector<ContactRow<S>>&);                                     \
+  template void solveContactVelocities(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&,   \
+                                       std::vector<ContactRow<S>>&, const SolverSettings<S>&,        \
+                                       std::vector<CachedImpulse<S>>&);                              \
+  template void solveContactPositions(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&,    \
+                                      const std::vector<ContactRow<S>>&, S, const SolverSettings<S>&);
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE)
 #undef SG_INSTANTIATE
 }  // namespace sg

@@ -52,9 +52,10 @@ bool World<S>::bodiesFaulted(Stage stage) {
 
 template <class S>
 bool World<S>::respondToContacts() {
+  prepareContactRows(bodies_, contacts_, contactRows_);  // before gravity: the approach velocities
   applyGravity(bodies_, gravityDt_);
-  solveContactVelocities(bodies_, contacts_, solver_, impulseCache_);
-  solveContactPositions(bodies_, contacts_, solver_);
+  solveContactVelocities(bodies_, contacts_, contactRows_, solver_, impulseCache_);
+  solveContactPositions(bodies_, contacts_, contactRows_, particleConsts_.dt, solver_);
   if (bodiesFaulted(Stage::Response)) return false;
   mowGrass();
   // Grass: pushed out of every body (particle rows in parallel, bodies in id order).

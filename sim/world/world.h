@@ -147,6 +147,7 @@ class World final : public SimWorld {
   std::vector<Contact<S>> contacts_;
   std::vector<CachedImpulse<S>> impulseCache_;  ///< warm-start impulses (state)
   SolverSettings<S> solver_;
+  std::vector<ContactRow<S>> contactRows_;  ///< scratch of the response stage (not state)
   BodyParticleSettings<S> bodyParticle_;
   BodyBroadphase bodyBroadphase_ = BodyBroadphase::Brute;
   Vec3<S> gravityDt_ = Vec3<S>::Zero();
