@@ -359,3 +359,26 @@ TEST(Bodies, DegenerateStartsStayFinite) {
 
 }  // namespace
 }  // namespace sg
+
+namespace sg {
+namespace {
+// fx16 (issue 15): the sleep test squared the speed, and 181 m/s squared is beyond Q16.16: a body
+// faster than that faulted at tick 0. 200 m/s (and 4000 m/s) must step; the body is still
+// judged "not still", and a slow one still falls asleep.
+TEST(Bodies, Fx16FastBodyDoesNotOverflowInTheSleepTest) {
+  for (int64_t speed : {200, 4000}) {
+    Scenario s = emptyWorld();
+    s.bodies.gravity = r3(0, 0, 0);
+    s.bodies.list = {sphere("fast", Rational{1, 10}, r3(0, 50, 0))};
+    s.bodies.list[0].velocity[0] = Rational::integer(speed);
+    auto w = makeTyped<Fx16>(s);
+    for (int t = 0; t < 3; ++t) {
+      const StepResult r = w->step(TickInput{});
+      ASSERT_TRUE(r.ok) << speed << " m/s, tick " << t << ": " << r.error.message();
+    }
+    EXPECT_FALSE(w->bodies()[0].asleep);
+    EXPECT_EQ(w->bodies()[0].stillTicks, 0);
+  }
+}
+}  // namespace
+}  // namespace sg

@@ -281,9 +281,10 @@ TEST(RecordingLimits, DiffReservesNothingForTheTicksARecordingClaims) {
   h.checkEvery = 0;
   h.snapshotEvery = 0;
   std::vector<Chunk> chunks{{sgr::ChunkType::Head, sgr::encodeHead(h)}};
-  TickInput blast;
-  blast.bodies.push_back(
-      BodyCommand{0, BodyCommandKind::AddVelocity, InputVec3{int64_t(1) << 62, int64_t(1) << 62, int64_t(1) << 62}});
+  TickInput blast;  // 2^30 m/s twice: the velocity overflows Q32.32 as the inputs are applied
+  for (int twice = 0; twice < 2; ++twice)
+    blast.bodies.push_back(
+        BodyCommand{0, BodyCommandKind::AddVelocity, InputVec3{int64_t(1) << 62, int64_t(1) << 62, int64_t(1) << 62}});
   chunks.push_back({sgr::ChunkType::Input, sgr::encodeInput(0, blast, TickInput{})});
   TickInput camera;
   int64_t tick = 0;
@@ -439,12 +440,15 @@ TEST(RecordingLimits, ARecordingMissingItsLastSnapshotOrItsChecksIsDamaged) {
 }
 
 TEST(RecordingLimits, ARecordingThatFaultedOnItsLastInputVerifies) {
-  // The command of tick 2 (within the input range, so accepted at load) makes the ball's velocity
-  // overflow in the step from tick 2: END (faulted,
+  // The commands of tick 2 (each within the input range, so accepted at load) make the ball's
+  // velocity overflow in the step from tick 2: END (faulted,
   // tick 2) follows the INPT of tick 2. Such a recording was refused as "a final tick from 3".
   TempDir dir;
   nlohmann::json s = nlohmann::json::parse(readFile(tinyScenario()));
-  s["script"] = {{{"tick", 2}, {"body", "ball"}, {"command", "addVelocity"}, {"value", {5e8, 5e8, 5e8}}}};
+  // Five commands of 5e8 m/s (each within the input range) add up beyond Q32.32's 2.1e9.
+  s["script"] = nlohmann::json::array();
+  for (int i = 0; i < 5; ++i)
+    s["script"].push_back({{"tick", 2}, {"body", "ball"}, {"command", "addVelocity"}, {"value", {5e8, 5e8, 5e8}}});
   const std::string scenario = dir.write("fault.json", s.dump());
   const std::string out = dir.file("fault.sgr");
   const CliResult rec = runCli("record " + quote(scenario) + " -o " + quote(out) + " --ticks 20");
@@ -528,9 +532,10 @@ TEST(RecordingLimits, AReplayThatFaultedBeforeItsTargetWritesNoState) {
   h.checkEvery = 0;
   h.snapshotEvery = 0;
   std::vector<Chunk> chunks{{sgr::ChunkType::Head, sgr::encodeHead(h)}};
-  TickInput blast;
-  blast.bodies.push_back(
-      BodyCommand{0, BodyCommandKind::AddVelocity, InputVec3{int64_t(1) << 62, int64_t(1) << 62, int64_t(1) << 62}});
+  TickInput blast;  // 2^30 m/s twice: the velocity overflows Q32.32 as the inputs are applied
+  for (int twice = 0; twice < 2; ++twice)
+    blast.bodies.push_back(
+        BodyCommand{0, BodyCommandKind::AddVelocity, InputVec3{int64_t(1) << 62, int64_t(1) << 62, int64_t(1) << 62}});
   chunks.push_back({sgr::ChunkType::Input, sgr::encodeInput(0, blast, TickInput{})});
   sgr::EndInfo e;
   e.tick = 10;

@@ -83,7 +83,10 @@ RigidBody<S> makeBody(const BodySpec& spec, const Rational& dt, const std::strin
     b.parts.push_back(part);
   }
   b.invMass = toS<S>(x.div(Rational{1, 1}, spec.mass));
-  for (int a = 0; a < 3; ++a) b.invInertiaLocal[a] = toS<S>(x.div(Rational{1, 1}, inertia[a]));
+  for (int a = 0; a < 3; ++a) {
+    b.invInertiaLocal[a] = toS<S>(x.div(Rational{1, 1}, inertia[a]));
+    b.inertiaLocal[a] = toS<S>(inertia[a]);
+  }
   b.linearDampingPerTick = toS<S>(deterministicPow(spec.linearDamping, dt));
   b.angularDampingPerTick = toS<S>(deterministicPow(spec.angularDamping, dt));
   b.restitution = toS<S>(spec.restitution);

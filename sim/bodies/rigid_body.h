@@ -26,6 +26,7 @@ struct RigidBody {
   std::vector<BodyPart<S>> parts;
   S invMass{};                                          ///< 1/kg
   Vec3<S> invInertiaLocal = Vec3<S>::Zero();            ///< principal inverse inertia (body axes), 1/(kg m^2)
+  Vec3<S> inertiaLocal = Vec3<S>::Zero();               ///< principal inertia (body axes), kg m^2 (gyroscopic term)
   S linearDampingPerTick{1}, angularDampingPerTick{1};  ///< damping^dt
   S restitution{}, friction{};
   S boundingRadius{};  ///< m, around the centre of mass: covers every part

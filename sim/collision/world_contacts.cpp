@@ -1,6 +1,7 @@
 // The body stages of World<S>: collision detection (body pairs through the selected broad
-// phase, then bodies against the terrain) and the response (gravity, contact impulses, position
+// phase, then bodies against the terrain) and the response (gravity, the gyroscopic term, contact impulses, position
 // projection, mowing, and the grass pushed out of every body, with optional grass drag).
+#include "sim/bodies/gyroscopic.h"
 #include "sim/bodies/integrate_bodies.h"
 #include "sim/collision/body_pairs.h"
 #include "sim/world/world.h"
@@ -54,6 +55,7 @@ template <class S>
 bool World<S>::respondToContacts() {
   prepareContactRows(bodies_, contacts_, contactRows_);  // before gravity: the approach velocities
   applyGravity(bodies_, gravityDt_);
+  applyGyroscopicTerm(bodies_, particleConsts_.dt);
   solveContactVelocities(bodies_, contacts_, contactRows_, solver_, impulseCache_);
   solveContactPositions(bodies_, contacts_, contactRows_, particleConsts_.dt, solver_);
   if (bodiesFaulted(Stage::Response)) return false;

@@ -289,7 +289,7 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
         (void)makeBody<S>(b, s.timeStep, s.sourceName, q);
       } catch (const std::out_of_range&) {
         throw ScenarioError(s.sourceName, q + ".mass",
-                            std::string("mass properties (1/mass, 1/inertia) within the ") +
+                            std::string("mass properties (1/mass, inertia, 1/inertia) within the ") +
                                 scalarName(ScalarTraits<S>::kind) + " range");
       }
       if (takeFixedFaults() != 0)
