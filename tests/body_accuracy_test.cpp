@@ -497,3 +497,27 @@ TEST(BodyAccuracy, StackAndSlopeAreThreadCountIndependentDouble) { expectThreadC
 
 }  // namespace
 }  // namespace sg
+
+namespace sg {
+namespace {
+// A box resting on the level ground beyond a heightmap's edge (issue 15): the ground there is the
+// edge samples extended, level along x, but its normal kept the edge cell's 1:4 slope and the
+// box slid away down a slope that is not there. It must stay put, at the edge height (4 m).
+template <class S>
+void expectBoxBeyondTheEdgeStaysPut(const char* name) {
+  Scenario s = test::slope();  // the map spans x in [-8, 8]; beyond x = 8 the ground is 4 m high
+  // Friction 0.1: below the 1:4 slope's friction angle, so a tilted normal would let it slide.
+  s.bodies.list = {cube("box", test::r3(48, 17, 0, 4), Rational{1, 10})};  // x = 12, resting at y = 4.25
+  s.bodies.list[0].canSleep = false;
+  auto w = makeTyped<S>(s);
+  run(*w, s, 300);
+  const auto& b = w->bodies()[0];
+  EXPECT_NEAR(ScalarTraits<S>::toDouble(b.position.x()), 12.0, 0.001) << name;
+  EXPECT_NEAR(ScalarTraits<S>::toDouble(b.position.z()), 0.0, 0.001) << name;
+  EXPECT_NEAR(ScalarTraits<S>::toDouble(b.position.y()), 4.25, 0.003) << name;  // gravity's g dt^2 sink, as flat ground
+}
+TEST(BodyAccuracy, BoxBeyondAHeightmapEdgeStaysPutDouble) { expectBoxBeyondTheEdgeStaysPut<double>("double"); }
+TEST(BodyAccuracy, BoxBeyondAHeightmapEdgeStaysPutFx32) { expectBoxBeyondTheEdgeStaysPut<Fx32>("fx32"); }
+TEST(BodyAccuracy, BoxBeyondAHeightmapEdgeStaysPutFx16) { expectBoxBeyondTheEdgeStaysPut<Fx16>("fx16"); }
+}  // namespace
+}  // namespace sg

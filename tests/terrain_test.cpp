@@ -2,9 +2,12 @@
 // clamping, and patch roots on the ground.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <type_traits>
+#include <utility>
 
 #include "tests/test_support.h"
 
@@ -75,6 +78,42 @@ TEST(Terrain, EdgeSamplesExtendOutsideTheMap) {
   EXPECT_NEAR(t.heightAt(100, 100), (4 * 8 + 4) / 50.0, 1e-14);
   EXPECT_NEAR(t.heightAt(-100, 0), 2 / 50.0, 1e-14);
 }
+
+// Beyond the map the edge samples extend, so the ground there is level along the axis it is
+// beyond: the normal has no slope along it (it kept the edge cell's tilt, and a body resting beyond
+// the edge slid away, issue 15). Along the edge the slope is kept; inside, nothing changes.
+template <class S>
+void expectNormalsBeyondTheEdge() {
+  Terrain<S> t = terrainOf<S>(rampTerrain(9, 5));  // x in [-2, 2], z in [-1, 1]; dh/dx 0.16, dh/dz 0.04
+  auto normal = [&](double x, double z) {
+    S nx, ny, nz;
+    auto at = [](double v) { return *ScalarTraits<S>::fromRational(*Rational::make(std::llround(v * 10), 10)); };
+    t.normalAt(at(x), at(z), &nx, &ny, &nz);
+    return std::array<double, 3>{ScalarTraits<S>::toDouble(nx), ScalarTraits<S>::toDouble(ny),
+                                 ScalarTraits<S>::toDouble(nz)};
+  };
+  const double tol = std::is_same_v<S, Fx16> ? 2e-4 : 1e-6;                      // Q16.16: 1.5e-5 per rounding
+  for (const auto& [x, z] : {std::pair{3.0, 5.0}, {-7.0, -3.0}, {3.0, -1.5}}) {  // beyond both axes: level
+    const auto n = normal(x, z);
+    EXPECT_NEAR(n[0], 0, tol) << x << "," << z;
+    EXPECT_NEAR(n[1], 1, tol) << x << "," << z;
+    EXPECT_NEAR(n[2], 0, tol) << x << "," << z;
+  }
+  const double along = std::sqrt(1 + 0.04 * 0.04), across = std::sqrt(1 + 0.16 * 0.16);
+  const auto beyondX = normal(5.0, 0.3);  // beyond x only: the z slope of the edge row remains
+  EXPECT_NEAR(beyondX[0], 0, tol);
+  EXPECT_NEAR(beyondX[2], -0.04 / along, tol);
+  const auto beyondZ = normal(0.3, -4.0);  // beyond z only: the x slope remains
+  EXPECT_NEAR(beyondZ[0], -0.16 / across, tol);
+  EXPECT_NEAR(beyondZ[2], 0, tol);
+  const auto onLastSample = normal(2.0, 1.0);  // exactly on the last sample: still inside
+  const double both = std::sqrt(1 + 0.16 * 0.16 + 0.04 * 0.04);
+  EXPECT_NEAR(onLastSample[0], -0.16 / both, tol);
+  EXPECT_NEAR(onLastSample[2], -0.04 / both, tol);
+}
+TEST(Terrain, NormalBeyondTheEdgeIsLevelAlongThatAxisDouble) { expectNormalsBeyondTheEdge<double>(); }
+TEST(Terrain, NormalBeyondTheEdgeIsLevelAlongThatAxisFx32) { expectNormalsBeyondTheEdge<Fx32>(); }
+TEST(Terrain, NormalBeyondTheEdgeIsLevelAlongThatAxisFx16) { expectNormalsBeyondTheEdge<Fx16>(); }
 
 TEST(Terrain, FlatTerrain) {
   Scenario::Terrain flat;

@@ -35,16 +35,20 @@ typename Terrain<S>::Cell Terrain<S>::cellAt(S x, S z) const {
   if (c.ix < 0) {
     c.ix = 0;
     c.tx = S(0);
+    c.outsideX = true;
   }
   if (c.iz < 0) {
     c.iz = 0;
     c.tz = S(0);
+    c.outsideZ = true;
   }
   if (c.ix > width_ - 2) {
+    c.outsideX = c.ix > width_ - 1 || c.tx > S(0);  // exactly on the last sample is still inside
     c.ix = width_ - 2;
     c.tx = S(1);
   }
   if (c.iz > depth_ - 2) {
+    c.outsideZ = c.iz > depth_ - 1 || c.tz > S(0);
     c.iz = depth_ - 2;
     c.tz = S(1);
   }
@@ -71,8 +75,11 @@ void Terrain<S>::normalAt(S x, S z, S* nx, S* ny, S* nz) const {
   const Cell c = cellAt(x, z);
   const S h00 = sample(c.ix, c.iz), h10 = sample(c.ix + 1, c.iz);
   const S h01 = sample(c.ix, c.iz + 1), h11 = sample(c.ix + 1, c.iz + 1);
-  const S dhdx = lerp(h10 - h00, h11 - h01, c.tz) * invCellSize_;
-  const S dhdz = lerp(h01 - h00, h11 - h10, c.tx) * invCellSize_;
+  // Beyond the map along an axis the edge samples extend, so the height does not change along
+  // it: that slope is 0 (the edge cell's slope there tilted the normal of flat ground, and a body
+  // resting beyond the edge slid away).
+  const S dhdx = c.outsideX ? S(0) : lerp(h10 - h00, h11 - h01, c.tz) * invCellSize_;
+  const S dhdz = c.outsideZ ? S(0) : lerp(h01 - h00, h11 - h10, c.tx) * invCellSize_;
   const S len = length3(dhdx, S(1), dhdz);
   *nx = -dhdx / len;
   *ny = S(1) / len;

@@ -29,8 +29,9 @@ class Terrain {
 
  private:
   struct Cell {
-    int64_t ix, iz;  // lower sample indices
-    S tx, tz;        // in [0, 1]
+    int64_t ix, iz;                           // lower sample indices
+    S tx, tz;                                 // in [0, 1]
+    bool outsideX = false, outsideZ = false;  // beyond the map along that axis: the height is constant along it
   };
   Cell cellAt(S x, S z) const;
   S sample(int64_t ix, int64_t iz) const { return heights_[size_t(iz) * size_t(width_) + size_t(ix)]; }
