@@ -382,3 +382,61 @@ TEST(Bodies, Fx16FastBodyDoesNotOverflowInTheSleepTest) {
 }
 }  // namespace
 }  // namespace sg
+
+namespace sg {
+namespace {
+// A compound's centre of mass comes from its parts, whatever origin the author placed them
+// around (issue 15): the same dumbbell written around its left ball or around its middle moves
+// identically, spins about its middle, and a teleport names the origin as the scenario does.
+BodySpec dumbbell(const char* name, int64_t leftX10, Rational3 position) {
+  BodySpec b = sphere(name, Rational{1, 5}, position);
+  ShapeSpec right = b.parts[0];
+  b.parts[0].offset = r3(leftX10, 0, 0, 10);
+  right.offset = r3(leftX10 + 10, 0, 0, 10);  // 1 m to the right of the left ball
+  b.parts.push_back(right);
+  b.compound = true;
+  b.canSleep = false;
+  return b;
+}
+
+template <class S>
+void expectCentreOfMassFromTheParts(const char* name) {
+  Scenario s = emptyWorld();
+  // Around the left ball (origin at x = 0) and around the middle (origin at x = 0.5): the same
+  // dumbbell in space, 10 m apart in z; tossed and spinning, it falls onto the ground.
+  s.bodies.list = {dumbbell("left", 0, r3(0, 30, 0, 10)), dumbbell("middle", -5, r3(5, 30, 100, 10))};
+  for (BodySpec& b : s.bodies.list) {
+    b.velocity = r3(1, 2, 0);
+    b.angularVelocity = r3(0, 3, 1);
+  }
+  auto w = makeTyped<S>(s);
+  {
+    const auto& a = w->bodies()[0];
+    EXPECT_NEAR(ScalarTraits<S>::toDouble(a.position.x()), 0.5, 1e-6) << name << ": the middle";
+    EXPECT_NEAR(ScalarTraits<S>::toDouble(a.parts[0].offset.x()), -0.5, 1e-6) << name;
+  }
+  for (int t = 0; t < 240; ++t) {
+    ASSERT_TRUE(w->step(TickInput{}).ok) << name << " tick " << t;
+    const auto& a = w->bodies()[0];
+    const auto& b = w->bodies()[1];
+    for (size_t p = 0; p < 2; ++p)
+      for (int c = 0; c < 3; ++c) {
+        const double da = ScalarTraits<S>::toDouble(a.partPose(p).position[c]);
+        const double db = ScalarTraits<S>::toDouble(b.partPose(p).position[c]) - (c == 2 ? 10.0 : 0.0);
+        ASSERT_NEAR(da, db, 1e-6) << name << " tick " << t << " part " << p << " axis " << c;
+      }
+  }
+  // A teleport names the origin: the left ball of "left" lands exactly there.
+  TickInput in;
+  in.bodies.push_back(BodyCommand{0, BodyCommandKind::Teleport, InputVec3{0, int64_t(5) << 32, 0}});
+  ASSERT_TRUE(w->step(in).ok);
+  const auto& a = w->bodies()[0];
+  const Vec3<S> leftBall = a.partPose(0).position - a.velocity * ScalarTraits<S>::fromRational(s.timeStep).value();
+  EXPECT_NEAR(ScalarTraits<S>::toDouble(leftBall.x()), 0.0, 1e-6) << name;  // not the middle: that would be +-0.5 m off
+  EXPECT_NEAR(ScalarTraits<S>::toDouble(leftBall.y()), 5.0, 1e-6) << name;
+  EXPECT_NEAR(ScalarTraits<S>::toDouble(leftBall.z()), 0.0, 1e-6) << name;
+}
+TEST(Bodies, CompoundCentreOfMassFromThePartsDouble) { expectCentreOfMassFromTheParts<double>("double"); }
+TEST(Bodies, CompoundCentreOfMassFromThePartsFx32) { expectCentreOfMassFromTheParts<Fx32>("fx32"); }
+}  // namespace
+}  // namespace sg

@@ -34,8 +34,8 @@ void World<S>::applyCommands(const TickInput& input) {
       case BodyCommandKind::Impulse:
         b.velocity += v * b.invMass;
         break;
-      case BodyCommandKind::Teleport:
-        b.position = v;
+      case BodyCommandKind::Teleport:  // v names the body's origin, as the scenario's position does
+        b.position = v + b.rotation * b.centreOfMassLocal;
         b.velocity = Vec3<S>::Zero();
         b.angularVelocity = Vec3<S>::Zero();
         break;
@@ -58,7 +58,9 @@ void World<S>::resetBody(size_t body) {
   const size_t scenarioBodies = initialBodies_.size();
   const RigidBody<S>& start = initialBodies_[size_t(bodyTemplate(int64_t(body)))];
   RigidBody<S>& b = bodies_[body];
-  b.position = body < scenarioBodies ? start.position : inputVector<S>(spawns_[body - scenarioBodies].position);
+  b.position = body < scenarioBodies
+                   ? start.position
+                   : inputVector<S>(spawns_[body - scenarioBodies].position) + start.rotation * start.centreOfMassLocal;
   b.orientation = start.orientation;
   b.velocity = Vec3<S>::Zero();
   b.angularVelocity = Vec3<S>::Zero();
@@ -74,7 +76,7 @@ void World<S>::spawnBody(int32_t templateBody, const InputVec3& at) {
   if (bodies_.size() >= size_t(kMaxBodies)) return;
   Spawned spawned{bodyTemplate(templateBody), at};  // a spawned template stands for its own template
   RigidBody<S> b = initialBodies_[size_t(spawned.templateBody)];
-  b.position = inputVector<S>(at);
+  b.position = inputVector<S>(at) + b.rotation * b.centreOfMassLocal;  // `at` names the origin
   b.velocity = Vec3<S>::Zero();
   b.angularVelocity = Vec3<S>::Zero();
   b.updateDerived();

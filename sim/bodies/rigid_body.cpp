@@ -26,6 +26,7 @@ struct Exact {
   }
   Rational mul(const Rational& a, const Rational& b) const { return (*this)(sg::mul(a, b)); }
   Rational add(const Rational& a, const Rational& b) const { return (*this)(sg::add(a, b)); }
+  Rational sub(const Rational& a, const Rational& b) const { return (*this)(sg::sub(a, b)); }
   Rational div(const Rational& a, const Rational& b) const { return (*this)(sg::div(a, b)); }
 };
 
@@ -54,9 +55,16 @@ RigidBody<S> makeBody(const BodySpec& spec, const Rational& dt, const std::strin
   RigidBody<S> b;
   Rational totalVolume{0, 1};
   for (const ShapeSpec& p : spec.parts) totalVolume = x.add(totalVolume, volumeOf(p, x));
+  // The centre of mass from the parts (mass split by volume), whatever origin the author placed
+  // the offsets around: the body turns about it and the inertia is taken about it.
+  Rational com[3] = {{0, 1}, {0, 1}, {0, 1}};
+  for (const ShapeSpec& p : spec.parts)
+    for (size_t a = 0; a < 3; ++a) com[a] = x.add(com[a], x.mul(x.div(volumeOf(p, x), totalVolume), p.offset[a]));
   Rational inertia[3] = {{0, 1}, {0, 1}, {0, 1}};
   using std::sqrt;
-  for (const ShapeSpec& p : spec.parts) {
+  for (const ShapeSpec& spec0 : spec.parts) {
+    ShapeSpec p = spec0;
+    for (size_t a = 0; a < 3; ++a) p.offset[a] = x.sub(p.offset[a], com[a]);  // from the centre of mass
     const Rational m = x.mul(spec.mass, x.div(volumeOf(p, x), totalVolume));
     Rational own[3];
     if (p.type == ShapeType::Sphere) {
@@ -93,9 +101,10 @@ RigidBody<S> makeBody(const BodySpec& spec, const Rational& dt, const std::strin
   b.friction = toS<S>(spec.friction);
   b.mower = spec.mower;
   b.canSleep = spec.canSleep;
-  b.position = toS3<S>(spec.position);
   b.orientation = normalizedQuat(Quat<S>(toS<S>(spec.orientation[0]), toS<S>(spec.orientation[1]),
                                          toS<S>(spec.orientation[2]), toS<S>(spec.orientation[3])));
+  b.centreOfMassLocal = Vec3<S>(toS<S>(com[0]), toS<S>(com[1]), toS<S>(com[2]));
+  b.position = toS3<S>(spec.position) + b.orientation.toRotationMatrix() * b.centreOfMassLocal;
   b.velocity = toS3<S>(spec.velocity);
   b.angularVelocity = toS3<S>(spec.angularVelocity);
   b.updateDerived();

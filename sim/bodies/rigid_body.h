@@ -16,8 +16,8 @@ struct BodyPart {
   ShapeType type = ShapeType::Sphere;
   S radius{};                             ///< m (sphere)
   Vec3<S> halfExtents = Vec3<S>::Zero();  ///< m (box)
-  Vec3<S> offset = Vec3<S>::Zero();       ///< m, centre in the body frame (from the centre of mass)
-  S boundingRadius{};                     ///< m, around the part centre
+  Vec3<S> offset = Vec3<S>::Zero();  ///< m, centre in the body frame, from the centre of mass (not the author's origin)
+  S boundingRadius{};                ///< m, around the part centre
 };
 
 template <class S>
@@ -30,6 +30,10 @@ struct RigidBody {
   S linearDampingPerTick{1}, angularDampingPerTick{1};  ///< damping^dt
   S restitution{}, friction{};
   S boundingRadius{};  ///< m, around the centre of mass: covers every part
+  /// m, body frame: the centre of mass relative to the origin the scenario placed the parts
+  /// around (0 for a single shape and a symmetric compound). `position` is the centre of mass; a
+  /// scenario position, a teleport and a spawn name the origin.
+  Vec3<S> centreOfMassLocal = Vec3<S>::Zero();
   bool mower = false;
   bool canSleep = true;
   // --- state (saved, hashed) -----------------------------------------------------------------
@@ -55,7 +59,8 @@ struct RigidBody {
 /// Builds a body from its scenario description. Mass properties are exact fractions, rounded
 /// once into S: the thesis formulas (sphere 2/5 m r^2, box m/12 (dy^2 + dz^2), ...); a compound's
 /// mass split over its parts by volume (pi as 355/113, only in that ratio); the parallel-axis
-/// theorem. A compound's principal axes are taken to be the body axes (true for the symmetric
+/// theorem about the centre of mass, which is computed from the parts (the offsets may be around
+/// any origin). A compound's principal axes are taken to be the body axes (true for the symmetric
 /// layouts in scenarios/; off-diagonal products of inertia are dropped). `path` names the body
 /// in errors (ScenarioError when a value cannot be combined exactly).
 template <class S>

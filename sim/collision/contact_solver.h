@@ -31,9 +31,9 @@ namespace sg {
 template <class S>
 struct SolverSettings {
   int velocityIterations = 8;
-  int positionIterationsPerContact = 2;
-  S restitutionThreshold{};  ///< m/s
-  S linearSlop{};            ///< m: penetration the position pass leaves alone
+  int positionIterationsPerContact = 8;  // the scenario's bodies.positionIterations default
+  S restitutionThreshold{};              ///< m/s
+  S linearSlop{};                        ///< m: penetration the position pass leaves alone
 };
 
 /// Sorts contacts into their canonical order (bodyA, bodyB, featureA, featureB).

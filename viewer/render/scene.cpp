@@ -208,7 +208,9 @@ void extractTyped(const World<S>& w, const Scenario& scenario, Scene* scene) {
       const Mat3<S>& rotation = body.rotation;
       for (int c = 0; c < 3; ++c)
         for (int r = 0; r < 3; ++r) d.model[size_t(c * 4 + r)] = float(toD(rotation(r, c)));
-      for (int r = 0; r < 3; ++r) d.model[size_t(12 + r)] = float(toD(body.position[r]));
+      // The mesh is authored around the scenario's origin for the body, not its centre of mass.
+      const Vec3<S> origin = body.position - rotation * body.centreOfMassLocal;
+      for (int r = 0; r < 3; ++r) d.model[size_t(12 + r)] = float(toD(origin[r]));
       paint(d, name, body.mower, b);
       d.firstProxy = uint32_t(scene->meshProxies.size());
       d.proxyCount = uint32_t(body.parts.size());
