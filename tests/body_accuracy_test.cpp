@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
 
 #include "tests/test_support.h"
@@ -519,5 +520,115 @@ void expectBoxBeyondTheEdgeStaysPut(const char* name) {
 TEST(BodyAccuracy, BoxBeyondAHeightmapEdgeStaysPutDouble) { expectBoxBeyondTheEdgeStaysPut<double>("double"); }
 TEST(BodyAccuracy, BoxBeyondAHeightmapEdgeStaysPutFx32) { expectBoxBeyondTheEdgeStaysPut<Fx32>("fx32"); }
 TEST(BodyAccuracy, BoxBeyondAHeightmapEdgeStaysPutFx16) { expectBoxBeyondTheEdgeStaysPut<Fx16>("fx16"); }
+}  // namespace
+}  // namespace sg
+
+namespace sg {
+namespace {
+// Friction angle +-0.25 deg (issue 15): a quarter degree past it the box accelerates at only
+// 4 cm/s^2, slow enough to pass the sleep test's speeds, and it fell asleep and never slid. A
+// contact whose friction is at its Coulomb limit now keeps its body awake. A quarter degree short
+// of it the box holds and sleeps. On flat ground under tilted gravity and on the 1:4 heightmap.
+struct FrictionAngleRun {
+  double along = 0;  // m moved along the slope, downhill positive
+  bool asleep = false;
+};
+
+template <class S>
+FrictionAngleRun onTheSlope(bool heightmap, double mu, double seconds) {
+  Scenario s = heightmap ? slope() : test::emptyWorld();
+  const Rational friction = q12(mu);
+  if (heightmap) {
+    s.bodies.list = {cubeOnSlope(0.0, friction)};
+  } else {  // flat ground, gravity tilted by theta towards +x
+    s.bodies.gravity = q12(kG * kSin, -kG * kCos, 0);
+    s.bodies.list = {cube("box", q12(0, 0.25, 0), friction)};
+  }
+  auto w = makeTyped<S>(s);
+  const auto& b = w->bodies()[0];
+  const double x0 = d(b.position.x()), y0 = d(b.position.y());
+  for (int64_t t = 0; t < std::llround(seconds / kDt); ++t) EXPECT_TRUE(w->step(TickInput{}).ok) << "tick " << t;
+  FrictionAngleRun r;
+  r.along =
+      heightmap ? -(alongSlope(d(b.position.x()), d(b.position.y())) - alongSlope(x0, y0)) : d(b.position.x()) - x0;
+  r.asleep = b.asleep;
+  return r;
+}
+
+template <class S>
+void expectFrictionAngleBoundary(const char* name, bool heightmap) {
+  const double quarter = 0.25 * std::numbers::pi / 180;
+  const double seconds = 6;
+  const double slideMu = std::tan(kTheta - quarter), holdMu = std::tan(kTheta + quarter);
+  const FrictionAngleRun slide = onTheSlope<S>(heightmap, slideMu, seconds);
+  const FrictionAngleRun hold = onTheSlope<S>(heightmap, holdMu, seconds);
+  const double a = kG * (kSin - slideMu * kCos);  // 0.043 m/s^2
+  const double expected = 0.5 * a * seconds * seconds;
+  if (std::getenv("SIMGRASS_PRINT_FRICTION"))
+    std::printf("[friction angle %s %s] slide %.4f m (a t^2/2 = %.4f m), %s; hold %.5f m, %s\n", name,
+                heightmap ? "heightmap" : "flat", slide.along, expected, slide.asleep ? "asleep" : "awake", hold.along,
+                hold.asleep ? "asleep" : "awake");
+  // Sliding: awake and near a t^2 / 2 (0.79 m). On flat ground within 2 % (measured 0.4 %: the
+  // tick the box settles in). On the heightmap the box meets the surface's sample points as
+  // contacts of their own (triangle contacts are issue 15's next step) and slides up to 18 % too
+  // far in double (2.7 % in fx32): held to [-5 %, +25 %] until then.
+  EXPECT_FALSE(slide.asleep) << name;
+  if (heightmap) {
+    EXPECT_GT(slide.along, 0.95 * expected) << name << " heightmap";
+    EXPECT_LT(slide.along, 1.25 * expected) << name << " heightmap";
+  } else {
+    EXPECT_NEAR(slide.along, expected, 0.02 * expected) << name << " flat";
+  }
+  // Holding: asleep, moved less than 5 mm (the creep bound of the static-friction test).
+  EXPECT_TRUE(hold.asleep) << name;
+  EXPECT_LT(std::fabs(hold.along), 0.005) << name << (heightmap ? " heightmap" : " flat");
+}
+TEST(BodyAccuracy, FrictionAngleBoundaryOnFlatGroundFx32) { expectFrictionAngleBoundary<Fx32>("fx32", false); }
+TEST(BodyAccuracy, FrictionAngleBoundaryOnFlatGroundFx16) { expectFrictionAngleBoundary<Fx16>("fx16", false); }
+TEST(BodyAccuracy, FrictionAngleBoundaryOnFlatGroundDouble) { expectFrictionAngleBoundary<double>("double", false); }
+TEST(BodyAccuracy, FrictionAngleBoundaryOnAHeightmapFx32) { expectFrictionAngleBoundary<Fx32>("fx32", true); }
+TEST(BodyAccuracy, FrictionAngleBoundaryOnAHeightmapDouble) { expectFrictionAngleBoundary<double>("double", true); }
+}  // namespace
+}  // namespace sg
+
+namespace sg {
+namespace {
+// Removing a support wakes what rested on it (issue 15): a box asleep on another box stayed
+// asleep in mid-air when the lower one was teleported away, displaced or reset.
+template <class S>
+void expectRemovedSupportWakesTheBodyOnIt(BodyCommandKind how, const char* name) {
+  Scenario s = test::emptyWorld();
+  s.bodies.list = {cube("lower", q12(0, 0.25, 0), Rational{1, 2}), cube("upper", q12(0, 0.75, 0), Rational{1, 2})};
+  s.bodies.list[1].name = "upper";
+  auto w = makeTyped<S>(s);
+  run(*w, s, 120);  // 2 s: both fall asleep (0.5 s below the speeds)
+  ASSERT_TRUE(w->bodies()[0].asleep && w->bodies()[1].asleep) << name << ": the stack did not fall asleep";
+  TickInput in;
+  const InputVec3 away{int64_t(20) << 32, int64_t(1) << 31, 0};  // 20 m aside (teleport) or by (displace)
+  in.bodies.push_back(BodyCommand{0, how, how == BodyCommandKind::Reset ? InputVec3{} : away});
+  if (how == BodyCommandKind::Reset) {  // a reset puts it back: move it first, let it sleep there
+    TickInput move;
+    move.bodies.push_back(BodyCommand{0, BodyCommandKind::Teleport, away});
+    ASSERT_TRUE(w->step(move).ok);
+    run(*w, s, 180);  // the upper box falls onto the ground and sleeps again
+    ASSERT_TRUE(w->bodies()[1].asleep) << name;
+    // Now the upper box rests on the ground at the lower one's start: the reset puts the lower
+    // box back into it, and the upper box must wake (and be pushed out).
+  }
+  ASSERT_TRUE(w->step(in).ok) << name;
+  EXPECT_FALSE(w->bodies()[1].asleep) << name << ": the body on the support stays asleep";
+  run(*w, s, 60);
+  if (how != BodyCommandKind::Reset)  // it fell the 0.5 m onto the ground
+    EXPECT_NEAR(d(w->bodies()[1].position.y()), 0.25, 0.01) << name;
+}
+TEST(BodyAccuracy, RemovedSupportWakesTheBodyOnItTeleportFx32) {
+  expectRemovedSupportWakesTheBodyOnIt<Fx32>(BodyCommandKind::Teleport, "teleport fx32");
+}
+TEST(BodyAccuracy, RemovedSupportWakesTheBodyOnItDisplaceDouble) {
+  expectRemovedSupportWakesTheBodyOnIt<double>(BodyCommandKind::Displace, "displace double");
+}
+TEST(BodyAccuracy, RemovedSupportWakesTheBodyOnItResetFx16) {
+  expectRemovedSupportWakesTheBodyOnIt<Fx16>(BodyCommandKind::Reset, "reset fx16");
+}
 }  // namespace
 }  // namespace sg

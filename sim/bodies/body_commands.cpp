@@ -24,6 +24,11 @@ void World<S>::applyCommands(const TickInput& input) {
     }
     wake(b);
     const Vec3<S> v = inputVector<S>(cmd.value);
+    // A body moved without moving through space (teleport, displace, reset) may leave what rested
+    // on it in mid-air, asleep with no contact to wake it: wake what was near where it was.
+    if (cmd.kind == BodyCommandKind::Teleport || cmd.kind == BodyCommandKind::Displace ||
+        cmd.kind == BodyCommandKind::Reset)
+      wakeBodiesNear(b.position, b.boundingRadius);
     switch (cmd.kind) {
       case BodyCommandKind::Displace:
         b.position += v;
@@ -47,6 +52,19 @@ void World<S>::applyCommands(const TickInput& input) {
       case BodyCommandKind::MowerOff:
         break;  // handled above
     }
+  }
+}
+
+template <class S>
+void World<S>::wakeBodiesNear(const Vec3<S>& centre, S radius) {
+  // Within the two bounding radii plus 5 cm along every axis (a box around the bounding sphere:
+  // a few more wake-ups in its corners, and no square that could overflow fx16 for big bodies).
+  const S margin = S(1) / S(20);
+  for (RigidBody<S>& other : bodies_) {
+    if (!other.asleep) continue;
+    const S reach = radius + other.boundingRadius + margin;
+    const Vec3<S> d = other.position - centre;
+    if (abs(d.x()) < reach && abs(d.y()) < reach && abs(d.z()) < reach) wake(other);
   }
 }
 
@@ -105,6 +123,7 @@ bool World<S>::bladeOn(int64_t body) const {
 #define SG_INSTANTIATE_COMMANDS(S)                              \
   template void World<S>::applyCommands(const TickInput&);      \
   template void World<S>::resetBody(size_t);                    \
+  template void World<S>::wakeBodiesNear(const Vec3<S>&, S);    \
   template void World<S>::spawnBody(int32_t, const InputVec3&); \
   template void World<S>::dropCachedImpulses(size_t);           \
   template int32_t World<S>::bodyTemplate(int64_t) const;       \

@@ -34,9 +34,6 @@ inline void integrateBodyPositions(std::vector<RigidBody<S>>& bodies, S dt) {
   }
 }
 
-/// Sleeping (a deterministic rule: integer counters and comparisons only). A body whose speed and
-/// angular speed both stay below the thresholds for `ticksToSleep` consecutive ticks falls asleep
-/// with zero velocities; it wakes when a command moves it or an awake body touches it.
 /// |v| < threshold, without squaring a large component: in fx16 a speed above 181 m/s squared
 /// overflows Q16.16 (a fast body faulted at tick 0 in the sleep test). A component at or above
 /// the threshold decides at once; below it every square is smaller than threshold^2.
@@ -47,12 +44,17 @@ inline bool slowerThan(const Vec3<S>& v, S threshold) {
   return v.squaredNorm() < threshold * threshold;
 }
 
+/// Sleeping (a deterministic rule: integer counters and comparisons only). A body whose speed and
+/// angular speed both stay below the thresholds, and none of whose contacts slid, for
+/// `ticksToSleep` consecutive ticks falls asleep with zero velocities; it wakes when a command
+/// moves it or a body near it, or when an awake body touches it.
 template <class S>
 inline void updateSleep(std::vector<RigidBody<S>>& bodies, S linearThreshold, S angularThreshold,
                         int32_t ticksToSleep) {
   for (RigidBody<S>& b : bodies) {
     if (!b.canSleep || b.asleep) continue;
-    const bool still = slowerThan(b.velocity, linearThreshold) && slowerThan(b.angularVelocity, angularThreshold);
+    const bool still = !b.slidingThisTick && slowerThan(b.velocity, linearThreshold) &&
+                       slowerThan(b.angularVelocity, angularThreshold);
     b.stillTicks = still ? b.stillTicks + 1 : 0;
     if (b.stillTicks >= ticksToSleep) {
       b.asleep = true;

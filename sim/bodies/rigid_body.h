@@ -44,6 +44,10 @@ struct RigidBody {
   int32_t stillTicks = 0;                     ///< consecutive ticks below the sleep thresholds
   bool asleep = false;                        ///< skips gravity and integration until woken
   bool bladeOn = true;                        ///< a mower cuts only while on (MowerOn/MowerOff)
+  // --- per tick, not state: set by the response stage, read by the sleep test of the same tick --
+  /// A contact of this body slid this tick (its friction impulse reached mu x normal impulse):
+  /// its contact forces cannot hold it, however slowly it moves, so it may not fall asleep.
+  bool slidingThisTick = false;
   // --- derived from the state (recomputed by updateDerived) ----------------------------------
   Mat3<S> rotation = Mat3<S>::Identity();
   Mat3<S> invInertiaWorld = Mat3<S>::Zero();

@@ -191,6 +191,22 @@ void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector
     row.impulseN = total;
     applyPair(bodies, row, Vec3<S>(row.normal * lambda));
   }
+  // Sliding: a body whose contacts' friction, summed, reached the summed Coulomb limits (a
+  // tangent impulse at +-mu x normal impulse is saturated). Such a body is not held by its
+  // contacts: a box a quarter degree past its friction angle accelerates at 4 cm/s^2, slow enough
+  // for the speed test, yet it must slide on. Summed per body, not per contact: one corner of a
+  // resting box may saturate while the others hold it (fx16 rounding did that).
+  std::vector<S> friction(bodies.size(), S(0)), limit(bodies.size(), S(0));
+  for (const ContactRow<S>& row : rows) {
+    const S used = maxS(abs(row.impulseT1), abs(row.impulseT2));
+    const S most = row.friction * row.impulseN;
+    for (const int32_t id : {row.a, row.b}) {
+      if (id == kTerrainBody) continue;
+      friction[size_t(id)] += used;
+      limit[size_t(id)] += most;
+    }
+  }
+  for (size_t i = 0; i < bodies.size(); ++i) bodies[i].slidingThisTick = limit[i] > S(0) && !(friction[i] < limit[i]);
   cache.clear();
   for (size_t i = 0; i < rows.size(); ++i)
     cache.push_back(CachedImpulse<S>{contacts[i].bodyA, contacts[i].bodyB, contacts[i].featureA, contacts[i].featureB,

@@ -96,6 +96,8 @@ class World final : public SimWorld {
   bool runParticleRows(Stage stage, Fn&& rowKernel);
   void applyCommands(const TickInput& input);
   void resetBody(size_t body);
+  void wakeBodiesNear(const Vec3<S>& centre,
+                      S radius);  ///< every sleeping body whose bounds come within 5 cm (per axis)
   void spawnBody(int32_t templateBody, const InputVec3& at);
   void dropCachedImpulses(size_t body);
   void detectContacts();
