@@ -440,3 +440,42 @@ TEST(Bodies, CompoundCentreOfMassFromThePartsDouble) { expectCentreOfMassFromThe
 TEST(Bodies, CompoundCentreOfMassFromThePartsFx32) { expectCentreOfMassFromTheParts<Fx32>("fx32"); }
 }  // namespace
 }  // namespace sg
+
+namespace sg {
+namespace {
+// The grid and brute grass broad phases are bit-identical anywhere in the field (issue 15, where
+// a tester saw them differ far from the origin in fx16): spheres at both far corners of a field
+// 8.2 km wide and in its middle, fx16 and fx32. The grid's lattice index is formed without
+// narrowing to the scalar (floorOfProduct), so it cannot wrap however far from the lattice
+// origin a body is.
+template <class S>
+void expectGrassBroadPhasesIdenticalAtTheFarCorners(const char* name) {
+  std::vector<uint64_t> hashes;
+  for (auto particles : {ParticleBroadphase::Grid, ParticleBroadphase::Brute}) {
+    Scenario s = test::thesisMeadow();
+    s.field.patchesX = 32800;  // x in [-4100, 4100] m at 0.25 m: 32,800 lattice columns
+    s.field.patchesZ = 4;
+    s.field.centerX = Rational{0, 1};
+    s.wind.schedule.clear();
+    s.bodies.particleBroadphase = particles;
+    s.bodies.list = {sphere("east", Rational{3, 10}, r3(40990, 3, 0, 10)),
+                     sphere("west", Rational{3, 10}, r3(-40990, 3, 0, 10)),
+                     sphere("middle", Rational{3, 10}, r3(0, 3, 0, 10))};
+    auto w = makeTyped<S>(s);
+    for (int t = 0; t < 30; ++t) {
+      const StepResult r = w->step(TickInput{});
+      ASSERT_TRUE(r.ok) << name << " tick " << t << ": " << r.error.message();
+    }
+    for (size_t b = 0; b < 3; ++b) EXPECT_LT(d(w->bodies()[b].position.y()), 0.31) << name << ": landed " << b;
+    hashes.push_back(w->stateHash());
+  }
+  EXPECT_EQ(hashes[0], hashes[1]) << name << ": grid and brute differ";
+}
+TEST(Bodies, GrassBroadPhasesAreBitIdenticalAtTheFieldsFarCornersFx16) {
+  expectGrassBroadPhasesIdenticalAtTheFarCorners<Fx16>("fx16");
+}
+TEST(Bodies, GrassBroadPhasesAreBitIdenticalAtTheFieldsFarCornersFx32) {
+  expectGrassBroadPhasesIdenticalAtTheFarCorners<Fx32>("fx32");
+}
+}  // namespace
+}  // namespace sg

@@ -618,8 +618,9 @@ void expectRemovedSupportWakesTheBodyOnIt(BodyCommandKind how, const char* name)
   ASSERT_TRUE(w->step(in).ok) << name;
   EXPECT_FALSE(w->bodies()[1].asleep) << name << ": the body on the support stays asleep";
   run(*w, s, 60);
-  if (how != BodyCommandKind::Reset)  // it fell the 0.5 m onto the ground
+  if (how != BodyCommandKind::Reset) {  // it fell the 0.5 m onto the ground
     EXPECT_NEAR(d(w->bodies()[1].position.y()), 0.25, 0.01) << name;
+  }
 }
 TEST(BodyAccuracy, RemovedSupportWakesTheBodyOnItTeleportFx32) {
   expectRemovedSupportWakesTheBodyOnIt<Fx32>(BodyCommandKind::Teleport, "teleport fx32");

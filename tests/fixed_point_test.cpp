@@ -18,6 +18,8 @@
 #include <vector>
 
 #include "sim/math/fixed.h"
+#include "sim/math/scalar.h"
+#include "sim/math/scalar_ops.h"
 #include "tests/printers.h"
 
 namespace {
@@ -991,3 +993,26 @@ TEST_F(FixedCompare, Fx32OperatorsFollowRawOrder) { comparisons<Fx32>(101); }
 TEST_F(FixedCompare, Fx16OperatorsFollowRawOrder) { comparisons<Fx16>(102); }
 
 }  // namespace
+
+namespace sg {
+namespace {
+// floorOfProduct: floor(a * b) as an integer where the product does not fit the scalar (a lattice
+// index far from the origin in Q16.16), and the same integer as floorToInt(a * b) where it does.
+TEST(FixedFloorOfProduct, BeyondTheRangeAndEqualWithin) {
+  const Fx16 far = Fx16::fromRaw(int32_t(8199) << 16 | (1 << 14));  // 8199.25 m
+  EXPECT_EQ(floorOfProduct(far, Fx16(4)), 32797);                   // beyond Q16.16's 32767.99
+  EXPECT_EQ(floorOfProduct(Fx16(-far), Fx16(4)), -32797);
+  EXPECT_EQ(takeFixedFaults(), 0u) << "no overflow raised";
+  uint64_t state = 0x9e3779b97f4a7c15ULL;
+  for (int i = 0; i < 20000; ++i) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    const Fx16 a = Fx16::fromRaw(int32_t(uint32_t(state >> 32)) >> 9);  // |a| < 64
+    const Fx16 b = Fx16::fromRaw(int32_t(uint32_t(state)) >> 9);
+    ASSERT_EQ(floorOfProduct(a, b), floorToInt(a * b)) << a.toDouble() << " x " << b.toDouble();
+    const Fx32 c = Fx32::fromRaw(int64_t(state) >> 20), e = Fx32::fromRaw(int64_t(state * 31) >> 22);
+    ASSERT_EQ(floorOfProduct(c, e), floorToInt(c * e)) << c.toDouble() << " x " << e.toDouble();
+  }
+  EXPECT_EQ(takeFixedFaults(), 0u);
+}
+}  // namespace
+}  // namespace sg

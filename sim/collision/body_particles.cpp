@@ -20,12 +20,13 @@ std::vector<ParticleRange> particleRanges(const std::vector<RigidBody<S>>& bodie
       } else {
         const Vec3<S> c = body.partPose(p).position;
         const S reach = body.parts[p].boundingRadius + s.margin;
-        r.a0 = std::max<int64_t>(w.originI, floorToInt((c.x() - reach - s.anchorOriginX) * s.invParticleSpacing));
-        r.a1 =
-            std::min<int64_t>(w.endI() - 1, floorToInt((c.x() + reach - s.anchorOriginX) * s.invParticleSpacing) + 1);
-        r.b0 = std::max<int64_t>(w.originJ, floorToInt((c.z() - reach - s.anchorOriginZ) * s.invParticleSpacing));
-        r.b1 =
-            std::min<int64_t>(w.endJ() - 1, floorToInt((c.z() + reach - s.anchorOriginZ) * s.invParticleSpacing) + 1);
+        // floorOfProduct: the index may exceed the scalar's range (fx16 far corners) though the
+        // coordinate difference does not (coordinates are within a quarter of the range).
+        const S inv = s.invParticleSpacing;
+        r.a0 = std::max<int64_t>(w.originI, floorOfProduct(S(c.x() - reach - s.anchorOriginX), inv));
+        r.a1 = std::min<int64_t>(w.endI() - 1, floorOfProduct(S(c.x() + reach - s.anchorOriginX), inv) + 1);
+        r.b0 = std::max<int64_t>(w.originJ, floorOfProduct(S(c.z() - reach - s.anchorOriginZ), inv));
+        r.b1 = std::min<int64_t>(w.endJ() - 1, floorOfProduct(S(c.z() + reach - s.anchorOriginZ), inv) + 1);
       }
       out.push_back(r);
     }

@@ -121,6 +121,12 @@ class Fixed {
     // |a*b| <= 2^(2*kRawBits - 2): the wide product never overflows.
     return fromRaw(narrow(roundShift(Wide(a.raw_) * Wide(b.raw_))));
   }
+  /// floor(a * b) as an integer, with the product rounded as operator* rounds it but never
+  /// narrowed to Raw: the same integer as floorToInt(a * b) wherever a * b fits, and the right one
+  /// where it does not (a lattice index far from the origin in Q16.16).
+  static constexpr int64_t floorOfProduct(Fixed a, Fixed b) noexcept {
+    return int64_t(roundShift(Wide(a.raw_) * Wide(b.raw_)) >> Frac);
+  }
   friend constexpr Fixed operator/(Fixed a, Fixed b) noexcept {
     if (b.raw_ == 0) {
       detail::raiseFixedFault(kFixedFaultDivideByZero);

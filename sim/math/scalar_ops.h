@@ -18,6 +18,18 @@ inline int64_t floorToInt(S v) {
   }
 }
 
+/// floor(a * b) as an integer, for an index (a coordinate times an inverse spacing) that may not
+/// fit the scalar itself: in Q16.16 a corner 16,000 m from the lattice origin times 4 per metre is
+/// 64,000, beyond its 32,767 (the grid broad phase then lost particles brute force found).
+template <class S>
+inline int64_t floorOfProduct(S a, S b) {
+  if constexpr (ScalarTraits<S>::isFixed) {
+    return S::floorOfProduct(a, b);
+  } else {
+    return int64_t(std::floor(a * b));
+  }
+}
+
 /// v - floor(v), in [0, 1).
 template <class S>
 inline S fractionalPart(S v) {

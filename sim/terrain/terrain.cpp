@@ -20,6 +20,10 @@ Terrain<S>::Terrain(const Scenario::Terrain& t, const ScenarioConstants& c)
   invCellSize_ = exact<S>(c.terrainInvCellSize);
   originX_ = exact<S>(c.terrainOriginX);  // sample (0, 0) sits at centre - cellSize * (n - 1) / 2
   originZ_ = exact<S>(c.terrainOriginZ);
+  loX_ = originX_ - mulInt(cellSize_, 2);
+  hiX_ = originX_ + mulInt(cellSize_, width_ + 1);
+  loZ_ = originZ_ - mulInt(cellSize_, 2);
+  hiZ_ = originZ_ + mulInt(cellSize_, depth_ + 1);
   S table[256];
   for (int v = 0; v < 256; ++v) table[v] = exact<S>(c.terrainHeightOfSample[size_t(v)]);
   heights_.resize(t.heightmap.samples.size());
@@ -28,8 +32,8 @@ Terrain<S>::Terrain(const Scenario::Terrain& t, const ScenarioConstants& c)
 
 template <class S>
 typename Terrain<S>::Cell Terrain<S>::cellAt(S x, S z) const {
-  const S fx = (x - originX_) * invCellSize_;
-  const S fz = (z - originZ_) * invCellSize_;
+  const S fx = (std::clamp(x, loX_, hiX_) - originX_) * invCellSize_;
+  const S fz = (std::clamp(z, loZ_, hiZ_) - originZ_) * invCellSize_;
   Cell c{floorToInt(fx), floorToInt(fz), fractionalPart(fx), fractionalPart(fz)};
   // Clamp outside the map: the edge sample extends (t = 0 at the low edge, t = 1 at the high).
   if (c.ix < 0) {
@@ -90,10 +94,12 @@ template <class S>
 void Terrain<S>::samplesInside(S x, S z, S radius, std::vector<std::pair<S, S>>& out) const {
   out.clear();
   if (flat_) return;
-  const int64_t x0 = std::max<int64_t>(0, floorToInt((x - radius - originX_) * invCellSize_));
-  const int64_t x1 = std::min<int64_t>(width_ - 1, floorToInt((x + radius - originX_) * invCellSize_) + 1);
-  const int64_t z0 = std::max<int64_t>(0, floorToInt((z - radius - originZ_) * invCellSize_));
-  const int64_t z1 = std::min<int64_t>(depth_ - 1, floorToInt((z + radius - originZ_) * invCellSize_) + 1);
+  const int64_t x0 = std::max<int64_t>(0, floorToInt((std::clamp(x - radius, loX_, hiX_) - originX_) * invCellSize_));
+  const int64_t x1 =
+      std::min<int64_t>(width_ - 1, floorToInt((std::clamp(x + radius, loX_, hiX_) - originX_) * invCellSize_) + 1);
+  const int64_t z0 = std::max<int64_t>(0, floorToInt((std::clamp(z - radius, loZ_, hiZ_) - originZ_) * invCellSize_));
+  const int64_t z1 =
+      std::min<int64_t>(depth_ - 1, floorToInt((std::clamp(z + radius, loZ_, hiZ_) - originZ_) * invCellSize_) + 1);
   for (int64_t iz = z0; iz <= z1; ++iz)
     for (int64_t ix = x0; ix <= x1; ++ix)
       out.emplace_back(originX_ + mulInt(cellSize_, ix), originZ_ + mulInt(cellSize_, iz));

@@ -40,6 +40,10 @@ class Terrain {
   S flatHeight_{};
   int64_t width_ = 0, depth_ = 0;
   S cellSize_{}, invCellSize_{}, originX_{}, originZ_{};
+  /// Two cells beyond the map on each side: coordinates are clamped into [lo, hi] before they are
+  /// scaled to cells, so the cell coordinate fits the scalar (in Q16.16 a point 16,000 m from a
+  /// 0.25 m map's origin is 64,000 cells away, beyond its range) and beyond-the-edge stays so.
+  S loX_{}, hiX_{}, loZ_{}, hiZ_{};
   std::vector<S> heights_;
 };
 
