@@ -102,6 +102,21 @@ std::vector<uint8_t> withHead(const std::vector<uint8_t>& head) {
   return assemble(chunks);
 }
 
+/// tiny.sgr's HEAD without hashes or snapshots, and an INPT at tick 0 whose commands (2^30 m/s,
+/// twice) overflow the ball's velocity in Q32.32 as they are applied: a replay faults at once.
+std::vector<Chunk> faultingAtTickZero() {
+  sgr::Header h = tinyHeader();
+  h.checkEvery = 0;
+  h.snapshotEvery = 0;
+  std::vector<Chunk> chunks{{sgr::ChunkType::Head, sgr::encodeHead(h)}};
+  TickInput blast;
+  for (int twice = 0; twice < 2; ++twice)
+    blast.bodies.push_back(
+        BodyCommand{0, BodyCommandKind::AddVelocity, InputVec3{int64_t(1) << 62, int64_t(1) << 62, int64_t(1) << 62}});
+  chunks.push_back({sgr::ChunkType::Input, sgr::encodeInput(0, blast, TickInput{})});
+  return chunks;
+}
+
 /// The last tick the INPT chunks of tiny.sgr name.
 int64_t lastInputTick() { return sgr::parseRecording(readBytes(tinyRecording()), "tiny.sgr").inputs.back().tick; }
 
@@ -277,15 +292,7 @@ TEST(RecordingLimits, DiffReservesNothingForTheTicksARecordingClaims) {
   // No hashes, an input every kMaxTickGap ticks up to ~2^26 ticks (all within the rules), and a
   // command at tick 0 that makes the ball's velocity overflow: both replays fault at once, so a
   // diff that reserved its series for every claimed tick (2^26 x 72 bytes) fails under 1 GB.
-  sgr::Header h = tinyHeader();
-  h.checkEvery = 0;
-  h.snapshotEvery = 0;
-  std::vector<Chunk> chunks{{sgr::ChunkType::Head, sgr::encodeHead(h)}};
-  TickInput blast;  // 2^30 m/s twice: the velocity overflows Q32.32 as the inputs are applied
-  for (int twice = 0; twice < 2; ++twice)
-    blast.bodies.push_back(
-        BodyCommand{0, BodyCommandKind::AddVelocity, InputVec3{int64_t(1) << 62, int64_t(1) << 62, int64_t(1) << 62}});
-  chunks.push_back({sgr::ChunkType::Input, sgr::encodeInput(0, blast, TickInput{})});
+  std::vector<Chunk> chunks = faultingAtTickZero();
   TickInput camera;
   int64_t tick = 0;
   for (int i = 1; i <= 1024; ++i) {
@@ -528,15 +535,7 @@ TEST(RecordingLimits, TheWriterRefusesTheChunkThatWouldPassTheReadersLimit) {
 TEST(RecordingLimits, AReplayThatFaultedBeforeItsTargetWritesNoState) {
   // No hashes and a command at tick 0 that makes the ball's velocity overflow: the replay faults
   // in the first step, long before --to 7; the state it stopped in is not tick 7's.
-  sgr::Header h = tinyHeader();
-  h.checkEvery = 0;
-  h.snapshotEvery = 0;
-  std::vector<Chunk> chunks{{sgr::ChunkType::Head, sgr::encodeHead(h)}};
-  TickInput blast;  // 2^30 m/s twice: the velocity overflows Q32.32 as the inputs are applied
-  for (int twice = 0; twice < 2; ++twice)
-    blast.bodies.push_back(
-        BodyCommand{0, BodyCommandKind::AddVelocity, InputVec3{int64_t(1) << 62, int64_t(1) << 62, int64_t(1) << 62}});
-  chunks.push_back({sgr::ChunkType::Input, sgr::encodeInput(0, blast, TickInput{})});
+  std::vector<Chunk> chunks = faultingAtTickZero();
   sgr::EndInfo e;
   e.tick = 10;
   chunks.push_back({sgr::ChunkType::End, sgr::encodeEnd(e)});

@@ -219,12 +219,9 @@ void solveContactPositions(std::vector<RigidBody<S>>& bodies, const std::vector<
   const size_t n = contacts.size();
   if (n == 0) return;
   std::vector<S> depth(n);
-  std::vector<Vec3<S>> rA(n), rB(n);
   for (size_t i = 0; i < n; ++i) {
     const S separating = maxS(relativeVelocity(bodies, rows[i]).dot(rows[i].normal), S(0));
     depth[i] = contacts[i].penetration - separating * dt;  // what integration will not remove
-    rA[i] = contacts[i].point - bodies[size_t(contacts[i].bodyA)].position;
-    if (contacts[i].bodyB != kTerrainBody) rB[i] = contacts[i].point - bodies[size_t(contacts[i].bodyB)].position;
   }
   const size_t iterations = size_t(settings.positionIterationsPerContact) * n;
   for (size_t it = 0; it < iterations; ++it) {
@@ -243,7 +240,7 @@ void solveContactPositions(std::vector<RigidBody<S>>& bodies, const std::vector<
     // body keeps its support instead of falling g dt^2 and being pushed back every other tick.
     deepest -= settings.linearSlop;
     const int32_t ids[2] = {c.bodyA, c.bodyB};
-    const Vec3<S>* arms[2] = {&rA[worst], &rB[worst]};
+    const Vec3<S>* arms[2] = {&rows[worst].rA, &rows[worst].rB};  // the arms the velocity pass used
     S linearInertia[2] = {S(0), S(0)}, angularInertia[2] = {S(0), S(0)};
     Vec3<S> angularPerUnit[2] = {Vec3<S>::Zero(), Vec3<S>::Zero()};
     S totalInertia(0);
@@ -283,8 +280,8 @@ void solveContactPositions(std::vector<RigidBody<S>>& bodies, const std::vector<
       body.updateDerived();
       // Every contact of this body loses (or gains) the depth this move removed.
       for (size_t i = 0; i < n; ++i) {
-        if (contacts[i].bodyA == ids[k]) depth[i] -= (dp + dTheta.cross(rA[i])).dot(contacts[i].normal);
-        if (contacts[i].bodyB == ids[k]) depth[i] += (dp + dTheta.cross(rB[i])).dot(contacts[i].normal);
+        if (contacts[i].bodyA == ids[k]) depth[i] -= (dp + dTheta.cross(rows[i].rA)).dot(contacts[i].normal);
+        if (contacts[i].bodyB == ids[k]) depth[i] += (dp + dTheta.cross(rows[i].rB)).dot(contacts[i].normal);
       }
     }
   }
