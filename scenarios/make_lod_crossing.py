@@ -50,7 +50,7 @@ scenario = {
     "terrain": {"type": "flat", "height": 0},
     "markings": {"center": [0, 0], "length": 30, "width": 20, "lineWidth": 0.5, "centerCircleRadius": 3},
     "lod": {"mode": "window", "window": [121, 121], "center": [START, START], "edgeSpacing": 4, "edgeRows": 20},
-    "bodies": {"velocityIterations": 8, "positionIterations": 2, "mowerCutHeight": 0.25,
+    "bodies": {"mowerCutHeight": 0.25,
                "list": [mower, football]},
     "script": script,
     "camera": camera,

@@ -531,6 +531,7 @@ namespace {
 // of it the box holds and sleeps. On flat ground under tilted gravity and on the 1:4 heightmap.
 struct FrictionAngleRun {
   double along = 0;  // m moved along the slope, downhill positive
+  double accel = 0;  // m/s^2 along the slope from the speed at 1 s and at the end (flat ground only)
   bool asleep = false;
 };
 
@@ -547,8 +548,14 @@ FrictionAngleRun onTheSlope(bool heightmap, double mu, double seconds) {
   auto w = makeTyped<S>(s);
   const auto& b = w->bodies()[0];
   const double x0 = d(b.position.x()), y0 = d(b.position.y());
-  for (int64_t t = 0; t < std::llround(seconds / kDt); ++t) EXPECT_TRUE(w->step(TickInput{}).ok) << "tick " << t;
+  const int64_t ticks = std::llround(seconds / kDt), second = std::llround(1 / kDt);
+  double v1 = 0;
+  for (int64_t t = 0; t < ticks; ++t) {
+    EXPECT_TRUE(w->step(TickInput{}).ok) << "tick " << t;
+    if (t + 1 == second) v1 = d(b.velocity.x());
+  }
   FrictionAngleRun r;
+  r.accel = (d(b.velocity.x()) - v1) / (seconds - 1);
   r.along =
       heightmap ? -(alongSlope(d(b.position.x()), d(b.position.y())) - alongSlope(x0, y0)) : d(b.position.x()) - x0;
   r.asleep = b.asleep;
@@ -568,8 +575,12 @@ void expectFrictionAngleBoundary(const char* name, bool heightmap) {
     std::printf("[friction angle %s %s] slide %.4f m (a t^2/2 = %.4f m), %s; hold %.5f m, %s\n", name,
                 heightmap ? "heightmap" : "flat", slide.along, expected, slide.asleep ? "asleep" : "awake", hold.along,
                 hold.asleep ? "asleep" : "awake");
-  // Sliding: awake and near a t^2 / 2 (0.79 m). On flat ground within 2 % (measured 0.4 %: the
-  // tick the box settles in). On the heightmap the box meets the surface's sample points as
+  // Sliding: awake and near a t^2 / 2 (0.79 m). On flat ground the acceleration (from the speeds
+  // at 1 s and 6 s) within 2 % of g (sin - mu cos): a Coulomb impulse mu N per sub-step, where N
+  // is off by 0.1 % already misses by 2 %. The distance also holds the cold start: the first tick
+  // has no warm-start impulses, and one solve and one relax sweep per sub-step let the box slip
+  // 0.8 cm/s before friction takes hold (1 sub-step: 3.2 cm/s), 5 cm over 6 s: within 10 %.
+  // On the heightmap the box meets the surface's sample points as
   // contacts of their own (triangle contacts are issue 15's next step) and slides up to 18 % too
   // far in double (2.7 % in fx32): held to [-5 %, +25 %] until then.
   EXPECT_FALSE(slide.asleep) << name;
@@ -577,7 +588,13 @@ void expectFrictionAngleBoundary(const char* name, bool heightmap) {
     EXPECT_GT(slide.along, 0.95 * expected) << name << " heightmap";
     EXPECT_LT(slide.along, 1.25 * expected) << name << " heightmap";
   } else {
-    EXPECT_NEAR(slide.along, expected, 0.02 * expected) << name << " flat";
+    // In fixed point a friction impulse of mu m g cos h per sub-step (0.0094 N s) is rounded to
+    // a unit of the format; near the friction angle that unit is a whole acceleration of
+    // unit / (m h): 2^-16 / (1 kg x 1/240 s) = 0.0037 m/s^2 in fx16 (8 % of a), 6e-8 in fx32.
+    double unitAccel = 0;
+    if constexpr (ScalarTraits<S>::isFixed) unitAccel = d(S::fromRaw(1)) / (1.0 * kDt / Scenario::Bodies{}.substeps);
+    EXPECT_NEAR(slide.accel, a, 0.02 * a + unitAccel) << name << " flat";
+    EXPECT_NEAR(slide.along, expected, 0.10 * expected + unitAccel * seconds * seconds / 2) << name << " flat";
   }
   // Holding: asleep, moved less than 5 mm (the creep bound of the static-friction test).
   EXPECT_TRUE(hold.asleep) << name;

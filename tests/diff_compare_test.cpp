@@ -254,7 +254,7 @@ constexpr const char* kSmallScenario = R"({
   "field": {"patchesX": 31, "patchesZ": 31, "spacing": 0.25},
   "particles": {"constraintLength": 0.5, "tiltDrop": [0.1, 0.15, 0.2]},
   "bodies": {
-    "velocityIterations": 8,
+    "substeps": 2,
     "list": [
       {"name": "football", "shape": {"type": "sphere", "radius": 0.3}, "mass": 0.45, "position": [-2, 0.3, -0.2],
        "restitution": 0.6, "friction": 0.6},

@@ -22,7 +22,7 @@ void World<S>::applyCommands(const TickInput& input) {
       if (b.mower) b.bladeOn = cmd.kind == BodyCommandKind::MowerOn;
       continue;
     }
-    wake(b);
+    wakeIsland(cmd.body);  // and whatever rests with it: pushing a support wakes its load
     const Vec3<S> v = inputVector<S>(cmd.value);
     // A body moved without moving through space (teleport, displace, reset) may leave what rested
     // on it in mid-air, asleep with no contact to wake it: wake what was near where it was.
@@ -60,11 +60,37 @@ void World<S>::wakeBodiesNear(const Vec3<S>& centre, S radius) {
   // Within the two bounding radii plus 5 cm along every axis (a box around the bounding sphere:
   // a few more wake-ups in its corners, and no square that could overflow fx16 for big bodies).
   const S margin = S(1) / S(20);
-  for (RigidBody<S>& other : bodies_) {
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    const RigidBody<S>& other = bodies_[i];
     if (!other.asleep) continue;
     const S reach = radius + other.boundingRadius + margin;
     const Vec3<S> d = other.position - centre;
-    if (abs(d.x()) < reach && abs(d.y()) < reach && abs(d.z()) < reach) wake(other);
+    // What that body rested on, or held up, wakes with it.
+    if (abs(d.x()) < reach && abs(d.y()) < reach && abs(d.z()) < reach) wakeIsland(int32_t(i));
+  }
+}
+
+template <class S>
+void World<S>::wakeIsland(int32_t body) {
+  // A sleeping island keeps no contacts, so its members are found by proximity: flood from the
+  // body through every sleeping body whose bounds come within 5 cm (per axis) of a woken one.
+  // Bodies are visited in id order from a stack of ids: the same wake-ups on every run.
+  const S margin = S(1) / S(20);
+  std::vector<int32_t> pending{body};
+  wake(bodies_[size_t(body)]);
+  while (!pending.empty()) {
+    const RigidBody<S>& from = bodies_[size_t(pending.back())];
+    pending.pop_back();
+    for (size_t i = 0; i < bodies_.size(); ++i) {
+      RigidBody<S>& other = bodies_[i];
+      if (!other.asleep) continue;
+      const S reach = from.boundingRadius + other.boundingRadius + margin;
+      const Vec3<S> d = other.position - from.position;
+      if (abs(d.x()) < reach && abs(d.y()) < reach && abs(d.z()) < reach) {
+        wake(other);
+        pending.push_back(int32_t(i));
+      }
+    }
   }
 }
 
@@ -124,6 +150,7 @@ bool World<S>::bladeOn(int64_t body) const {
   template void World<S>::applyCommands(const TickInput&);      \
   template void World<S>::resetBody(size_t);                    \
   template void World<S>::wakeBodiesNear(const Vec3<S>&, S);    \
+  template void World<S>::wakeIsland(int32_t);                  \
   template void World<S>::spawnBody(int32_t, const InputVec3&); \
   template void World<S>::dropCachedImpulses(size_t);           \
   template int32_t World<S>::bodyTemplate(int64_t) const;       \

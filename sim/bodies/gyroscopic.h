@@ -60,7 +60,10 @@ void applyGyroscopicTerm(std::vector<RigidBody<S>>& bodies, S dt) {
     using std::sqrt;
     const S before = inertia.dot(w.cwiseProduct(w)), after = inertia.dot(next.cwiseProduct(next));
     if (after > before && after > S(0)) next *= sqrt(before / after);
-    b.angularVelocity = b.rotation * next;
+    // Only the change goes back through R: a rounded R is orthonormal to ~1e-5 in fx16, and
+    // sending the whole of w out and back scaled it by that every step (|L| +22 %, energy +49 %
+    // in 20 s of fx16 sub-steps at 960 Hz); the change is small, and so is its error.
+    b.angularVelocity += b.rotation * Vec3<S>(next - w);
   }
 }
 

@@ -45,9 +45,10 @@ struct RigidBody {
   bool asleep = false;                        ///< skips gravity and integration until woken
   bool bladeOn = true;                        ///< a mower cuts only while on (MowerOn/MowerOff)
   // --- per tick, not state: set by the response stage, read by the sleep test of the same tick --
-  /// A contact of this body slid this tick (its friction impulse reached mu x normal impulse):
-  /// its contact forces cannot hold it, however slowly it moves, so it may not fall asleep.
-  bool slidingThisTick = false;
+  /// False when this body's contacts slid this tick (friction reached mu x normal impulse) or
+  /// overlap deeper than the slop (being pushed out): its contacts do not hold it where it is,
+  /// however slowly it moves, so it may not fall asleep.
+  bool heldThisTick = true;
   // --- derived from the state (recomputed by updateDerived) ----------------------------------
   Mat3<S> rotation = Mat3<S>::Identity();
   Mat3<S> invInertiaWorld = Mat3<S>::Zero();

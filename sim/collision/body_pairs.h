@@ -1,6 +1,7 @@
 // Body-body broad phase (thesis: all pairs, only three bodies) and the narrow-phase dispatch over
 // compound parts. "brute" tests every pair i < j; "sap" sorts bounding intervals along x and
-// sweeps. Both return the pairs whose bounding spheres overlap, sorted (i, j): identical lists.
+// sweeps. Both return the pairs whose bounding spheres, each grown by the body's reach this tick,
+// overlap, sorted (i, j): identical lists.
 #pragma once
 
 #include <algorithm>
@@ -13,44 +14,53 @@
 
 namespace sg {
 
+/// `reachA`, `reachB` (m): how far beyond its bounding sphere each body may touch this tick.
 template <class S>
-bool boundingSpheresOverlap(const RigidBody<S>& a, const RigidBody<S>& b) {
+bool boundingSpheresOverlap(const RigidBody<S>& a, const RigidBody<S>& b, S reachA, S reachB) {
   const Vec3<S> d = a.position - b.position;
-  const S reach = a.boundingRadius + b.boundingRadius;
+  const S reach = a.boundingRadius + b.boundingRadius + reachA + reachB;
   if (abs(d.x()) > reach || abs(d.y()) > reach || abs(d.z()) > reach) return false;
   return length3(d.x(), d.y(), d.z()) <= reach;
 }
 
+/// `reach[i]` (m, >= 0; empty: all 0) grows body i's bounding sphere (speculative contacts).
 template <class S>
-std::vector<std::pair<int32_t, int32_t>> bodyPairs(const std::vector<RigidBody<S>>& bodies, BodyBroadphase kind) {
+std::vector<std::pair<int32_t, int32_t>> bodyPairs(const std::vector<RigidBody<S>>& bodies, BodyBroadphase kind,
+                                                   const std::vector<S>& reach = {}) {
   std::vector<std::pair<int32_t, int32_t>> pairs;
   const int32_t n = int32_t(bodies.size());
+  auto grown = [&](int32_t i) { return reach.empty() ? S(0) : reach[size_t(i)]; };
+  auto overlap = [&](int32_t i, int32_t j) {
+    return boundingSpheresOverlap(bodies[size_t(i)], bodies[size_t(j)], grown(i), grown(j));
+  };
   if (kind == BodyBroadphase::Brute) {
     for (int32_t i = 0; i < n; ++i)
       for (int32_t j = i + 1; j < n; ++j)
-        if (boundingSpheresOverlap(bodies[size_t(i)], bodies[size_t(j)])) pairs.emplace_back(i, j);
+        if (overlap(i, j)) pairs.emplace_back(i, j);
     return pairs;
   }
   // Sweep and prune along x: order by interval start (id breaks ties), scan forward while the
   // next interval starts before this one ends.
   std::vector<int32_t> order(static_cast<size_t>(n));
   for (int32_t i = 0; i < n; ++i) order[size_t(i)] = i;
-  auto lo = [&](int32_t i) { return bodies[size_t(i)].position.x() - bodies[size_t(i)].boundingRadius; };
-  auto hi = [&](int32_t i) { return bodies[size_t(i)].position.x() + bodies[size_t(i)].boundingRadius; };
+  auto lo = [&](int32_t i) { return bodies[size_t(i)].position.x() - bodies[size_t(i)].boundingRadius - grown(i); };
+  auto hi = [&](int32_t i) { return bodies[size_t(i)].position.x() + bodies[size_t(i)].boundingRadius + grown(i); };
   std::stable_sort(order.begin(), order.end(), [&](int32_t a, int32_t b) { return lo(a) < lo(b); });
   for (size_t x = 0; x < order.size(); ++x)
     for (size_t y = x + 1; y < order.size() && !(lo(order[y]) > hi(order[x])); ++y) {
       const int32_t i = std::min(order[x], order[y]), j = std::max(order[x], order[y]);
-      if (boundingSpheresOverlap(bodies[size_t(i)], bodies[size_t(j)])) pairs.emplace_back(i, j);
+      if (overlap(i, j)) pairs.emplace_back(i, j);
     }
   std::sort(pairs.begin(), pairs.end());
   return pairs;
 }
 
 /// Contacts between bodies i < j over all their parts; features carry the part index in the
-/// upper 16 bits. Every contact has bodyA = i, bodyB = j.
+/// upper 16 bits. Every contact has bodyA = i, bodyB = j. Parts up to `speculative` (m) apart
+/// get speculative contacts (primitives.h).
 template <class S>
-void collideBodies(int32_t i, const RigidBody<S>& A, int32_t j, const RigidBody<S>& B, std::vector<Contact<S>>& out) {
+void collideBodies(int32_t i, const RigidBody<S>& A, int32_t j, const RigidBody<S>& B, std::vector<Contact<S>>& out,
+                   S speculative = S(0)) {
   for (size_t pi = 0; pi < A.parts.size(); ++pi)
     for (size_t pj = 0; pj < B.parts.size(); ++pj) {
       const BodyPart<S>& a = A.parts[pi];
@@ -58,19 +68,19 @@ void collideBodies(int32_t i, const RigidBody<S>& A, int32_t j, const RigidBody<
       const Pose<S> pa = A.partPose(pi), pb = B.partPose(pj);
       const size_t first = out.size();
       if (a.type == ShapeType::Sphere && b.type == ShapeType::Sphere) {
-        collideSphereSphere(i, pa.position, a.radius, j, pb.position, b.radius, out);
+        collideSphereSphere(i, pa.position, a.radius, j, pb.position, b.radius, out, speculative);
       } else if (a.type == ShapeType::Sphere) {
-        collideSphereBox(i, pa.position, a.radius, j, b.halfExtents, pb, out);
+        collideSphereBox(i, pa.position, a.radius, j, b.halfExtents, pb, out, speculative);
       } else if (b.type == ShapeType::Sphere) {
         // Box A, sphere B: solve as sphere-box with the roles swapped, then swap back.
-        collideSphereBox(j, pb.position, b.radius, i, a.halfExtents, pa, out);
+        collideSphereBox(j, pb.position, b.radius, i, a.halfExtents, pa, out, speculative);
         for (size_t k = first; k < out.size(); ++k) {
           std::swap(out[k].bodyA, out[k].bodyB);
           std::swap(out[k].featureA, out[k].featureB);
           out[k].normal = -out[k].normal;
         }
       } else {
-        collideBoxBox(i, a.halfExtents, pa, j, b.halfExtents, pb, out);
+        collideBoxBox(i, a.halfExtents, pa, j, b.halfExtents, pb, out, speculative);
       }
       for (size_t k = first; k < out.size(); ++k) {
         out[k].featureA |= uint32_t(pi) << 16;
@@ -79,16 +89,17 @@ void collideBodies(int32_t i, const RigidBody<S>& A, int32_t j, const RigidBody<
     }
 }
 
-/// Contacts of body i with the terrain over all its parts.
+/// Contacts of body i with the terrain over all its parts (speculative up to `speculative` m).
 template <class S>
-void collideBodyTerrain(int32_t i, const RigidBody<S>& A, const Terrain<S>& terrain, std::vector<Contact<S>>& out) {
+void collideBodyTerrain(int32_t i, const RigidBody<S>& A, const Terrain<S>& terrain, std::vector<Contact<S>>& out,
+                        S speculative = S(0)) {
   for (size_t p = 0; p < A.parts.size(); ++p) {
     const size_t first = out.size();
     const Pose<S> pose = A.partPose(p);
     if (A.parts[p].type == ShapeType::Sphere)
-      collideSphereTerrain(i, pose.position, A.parts[p].radius, terrain, out);
+      collideSphereTerrain(i, pose.position, A.parts[p].radius, terrain, out, speculative);
     else
-      collideBoxTerrain(i, A.parts[p].halfExtents, pose, terrain, out);
+      collideBoxTerrain(i, A.parts[p].halfExtents, pose, terrain, out, speculative);
     for (size_t k = first; k < out.size(); ++k) out[k].featureA |= uint32_t(p) << 16;
   }
 }

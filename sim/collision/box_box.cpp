@@ -64,10 +64,11 @@ Tolerances<S> tolerances() {
   return t;
 }
 
-/// x is smaller than y by more than the tolerance: x * (1 + rel) + absTol < y (m).
+/// x is smaller than y by more than the tolerance: x + |x| rel + absTol < y (m). |x|: a
+/// speculative (negative) overlap must be clearly smaller too, not clearly larger.
 template <class S>
 bool clearlyLess(S x, S y, S rel, S absTol) {
-  return x + x * rel + absTol < y;
+  return x + abs(x) * rel + absTol < y;
 }
 
 template <class S>
@@ -142,14 +143,15 @@ struct SatResult {
 };
 
 template <class S>
-SatResult<S> separatingAxisTest(const Relative<S>& rel, const Vec3<S>& ha, const Vec3<S>& hb, S margin, S edgeMinSin) {
+SatResult<S> separatingAxisTest(const Relative<S>& rel, const Vec3<S>& ha, const Vec3<S>& hb, S margin, S edgeMinSin,
+                                S speculative) {
   using std::abs;
   SatResult<S> r;
   // Faces of A: axis a_i. B's projection radius is sum_j hb_j |a_i . b_j|.
   for (int i = 0; i < 3; ++i) {
     const S rB = hb[0] * rel.absR(i, 0) + hb[1] * rel.absR(i, 1) + hb[2] * rel.absR(i, 2);
     const S pen = ha[i] + rB - abs(rel.t[i]);
-    if (pen < S(0)) return {true, {}, {}, {}};
+    if (pen < -speculative) return {true, {}, {}, {}};
     if (r.faceA.index < 0 || pen < r.faceA.pen) r.faceA = {i, pen};
   }
   // Faces of B: axis b_j.
@@ -157,7 +159,7 @@ SatResult<S> separatingAxisTest(const Relative<S>& rel, const Vec3<S>& ha, const
     const S rA = ha[0] * rel.absR(0, j) + ha[1] * rel.absR(1, j) + ha[2] * rel.absR(2, j);
     const S dist = rel.t[0] * rel.R(0, j) + rel.t[1] * rel.R(1, j) + rel.t[2] * rel.R(2, j);
     const S pen = hb[j] + rA - abs(dist);
-    if (pen < S(0)) return {true, {}, {}, {}};
+    if (pen < -speculative) return {true, {}, {}, {}};
     if (r.faceB.index < 0 || pen < r.faceB.pen) r.faceB = {3 + j, pen};
   }
   // Edge pairs. The unnormalised test |dist| > rA + rB is exact for L = 0 in exact arithmetic
@@ -167,9 +169,11 @@ SatResult<S> separatingAxisTest(const Relative<S>& rel, const Vec3<S>& ha, const
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       const EdgeAxis<S> e = edgeAxis(rel, ha, hb, i, j);
-      if (e.overlapU + margin < S(0)) return {true, {}, {}, {}};
-      if (e.len < edgeMinSin) continue;                               // (near) parallel edges: no contact axis
-      const S pen = (e.overlapU < S(0) ? S(0) : e.overlapU) / e.len;  // len >= edgeMinSin > 0
+      if (e.overlapU + margin + speculative * e.len < S(0)) return {true, {}, {}, {}};
+      if (e.len < edgeMinSin) continue;  // (near) parallel edges: no contact axis
+      // len >= edgeMinSin > 0. A gap counts only as a speculative contact; without one, rounding
+      // below zero is a touch.
+      const S pen = (e.overlapU < S(0) && speculative == S(0) ? S(0) : e.overlapU) / e.len;
       if (r.edge.index < 0 || pen < r.edge.pen) r.edge = {6 + 3 * i + j, pen};
     }
   return r;
@@ -230,10 +234,12 @@ ClipPolygon<S> clipAgainstPlane(const ClipPolygon<S>& in, int axis, bool negativ
 /// Face contacts with the reference face (axis k, outward sign) of box `ref` and the incident
 /// box `inc`; the incident face is the one most anti-parallel to the reference normal. Vertices
 /// up to `slack` above the face (rounding) still count, with penetration 0: boxes that touch
-/// within rounding get contacts whatever the rounding of each corner.
+/// within rounding get contacts whatever the rounding of each corner. Vertices further above,
+/// up to `speculative`, are speculative contacts (penetration = minus the gap).
 template <class S>
 int faceContacts(int32_t refBody, const Vec3<S>& hr, const Pose<S>& pr, int32_t incBody, const Vec3<S>& hi,
-                 const Pose<S>& pi, int k, bool negative, bool refIsA, S slack, std::vector<Contact<S>>& out) {
+                 const Pose<S>& pi, int k, bool negative, bool refIsA, S slack, S speculative,
+                 std::vector<Contact<S>>& out) {
   const Relative<S> rel = relative(pr, pi);  // incident box in the reference frame
   // Incident face: axis m with the largest |R(k, m)| (lowest index on ties), on the side facing
   // the reference face.
@@ -265,9 +271,11 @@ int faceContacts(int32_t refBody, const Vec3<S>& hr, const Pose<S>& pr, int32_t 
   for (int c = 0; c < poly.n && added < 8; ++c) {
     const Vec3<S>& p = poly.v[size_t(c)].p;
     const S depth = negative ? p[k] + hr[k] : hr[k] - p[k];  // m below the face
-    if (depth < -slack) continue;
+    if (depth < -(slack + speculative)) continue;
     Vec3<S> mid = p;
-    mid[k] = depth < S(0) ? faceCoord : halfOf(p[k] + faceCoord);
+    // Speculative (further above the face than rounding): the incident vertex itself, on the
+    // incident box, so its arm stays the size of the box however wide the gap.
+    if (depth >= -slack) mid[k] = depth < S(0) ? faceCoord : halfOf(p[k] + faceCoord);
     Contact<S> ct;
     ct.bodyA = refIsA ? refBody : incBody;
     ct.bodyB = refIsA ? incBody : refBody;
@@ -276,7 +284,7 @@ int faceContacts(int32_t refBody, const Vec3<S>& hr, const Pose<S>& pr, int32_t 
     ct.featureB = refIsA ? incFeature : refFeature;
     ct.point = pr.toWorld(mid);
     ct.normal = refIsA ? Vec3<S>(-refNormal) : refNormal;  // the reference normal points at the incident box
-    ct.penetration = depth < S(0) ? S(0) : depth;
+    ct.penetration = depth < -slack || depth >= S(0) ? depth : S(0);
     out.push_back(ct);
     ++added;
   }
@@ -337,13 +345,13 @@ EdgeContact<S> edgeContact(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, int3
 
 template <class S>
 int collideBoxBox(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, int32_t b, const Vec3<S>& hb, const Pose<S>& pb,
-                  std::vector<Contact<S>>& out) {
+                  std::vector<Contact<S>>& out, S speculative) {
   const Tolerances<S> tol = tolerances<S>();
   const Relative<S> rel = relative(pa, pb);
   // Rounding bound (m) for an overlap built from R: rounding units of R times the lever arms,
   // plus 1 m worth for the absolute rounding of fixed-point products at any size.
   const S margin = tol.roundoff * (ha.sum() + hb.sum() + S(1));
-  const SatResult<S> sat = separatingAxisTest(rel, ha, hb, margin, tol.edgeMinSin);
+  const SatResult<S> sat = separatingAxisTest(rel, ha, hb, margin, tol.edgeMinSin, speculative);
   if (sat.separated) return 0;
 
   // Contacts from one candidate axis; 0 when that axis yields none.
@@ -361,11 +369,11 @@ int collideBoxBox(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, int32_t b, co
     if (axis.index < 3) {
       // A's face towards B: sign of B's centre along a_i (t_i = 0, coincident centres: +).
       const int k = axis.index;
-      return faceContacts(a, ha, pa, b, hb, pb, k, rel.t[k] < S(0), true, margin, out);
+      return faceContacts(a, ha, pa, b, hb, pb, k, rel.t[k] < S(0), true, margin, speculative, out);
     }
     // B's face towards A: A's centre along b_j is -(t . b_j).
     const int k = axis.index - 3;
-    return faceContacts(b, hb, pb, a, ha, pa, k, rel.t.dot(rel.R.col(k)) > S(0), false, margin, out);
+    return faceContacts(b, hb, pb, a, ha, pa, k, rel.t.dot(rel.R.col(k)) > S(0), false, margin, speculative, out);
   };
 
   // First choice: least overlap, but B's faces and then the edges must be clearly better
@@ -391,7 +399,7 @@ int collideBoxBox(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, int32_t b, co
 
 #define SG_INSTANTIATE(S)                                                                                      \
   template int collideBoxBox(int32_t, const Vec3<S>&, const Pose<S>&, int32_t, const Vec3<S>&, const Pose<S>&, \
-                             std::vector<Contact<S>>&);
+                             std::vector<Contact<S>>&, S);
 SG_INSTANTIATE(Fx32)
 SG_INSTANTIATE(Fx16)
 SG_INSTANTIATE(float)

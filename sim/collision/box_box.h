@@ -48,8 +48,11 @@ inline constexpr uint32_t kBoxIncidentFaceStride = 0x100;
 /// Supported inputs (fuzz-tested): box sizes 0.01..100 m (half extents 0.005..50 m), positions
 /// within +-1000 m (fx32, float, double) or +-100 m (fx16); rotations proper (det +1) and
 /// orthonormal to the scalar's precision. No division by zero, no fixed-point fault there.
+/// With `speculative` > 0 (m), boxes up to that far apart get speculative contacts too
+/// (penetration = minus the gap, primitives.h): the separating tests allow that gap, incident
+/// vertices up to it above the reference face count, and an edge pair may be apart by it.
 template <class S>
 int collideBoxBox(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, int32_t b, const Vec3<S>& hb, const Pose<S>& pb,
-                  std::vector<Contact<S>>& out);
+                  std::vector<Contact<S>>& out, S speculative = S(0));
 
 }  // namespace sg

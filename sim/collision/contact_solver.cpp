@@ -76,47 +76,22 @@ bool sameKey(const CachedImpulse<S>& x, const Contact<S>& y) {
 }
 
 template <class S>
-void prepareContactRows(const std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
-                        std::vector<ContactRow<S>>& rows) {
-  using std::sqrt;
-  rows.assign(contacts.size(), ContactRow<S>{});
-  for (size_t i = 0; i < contacts.size(); ++i) {
-    const Contact<S>& c = contacts[i];
-    ContactRow<S>& row = rows[i];
-    row.a = c.bodyA;
-    row.b = c.bodyB;
-    const RigidBody<S>& A = bodies[size_t(c.bodyA)];
-    row.rA = c.point - A.position;
-    row.normal = c.normal;
-    row.t1 = tangentOf(c.normal);
-    row.t2 = c.normal.cross(row.t1);
-    S kN = inverseMassAlong(A, row.rA, row.normal);
-    S kT1 = inverseMassAlong(A, row.rA, row.t1);
-    S kT2 = inverseMassAlong(A, row.rA, row.t2);
-    row.restitution = A.restitution;
-    row.friction = A.friction;
-    if (c.bodyB != kTerrainBody) {
-      const RigidBody<S>& B = bodies[size_t(c.bodyB)];
-      row.rB = c.point - B.position;
-      kN += inverseMassAlong(B, row.rB, row.normal);
-      kT1 += inverseMassAlong(B, row.rB, row.t1);
-      kT2 += inverseMassAlong(B, row.rB, row.t2);
-      row.restitution = A.restitution < B.restitution ? B.restitution : A.restitution;
-      row.friction = sqrt(A.friction * B.friction);
-    }
-    row.massN = invertPositive(kN);
-    row.massT1 = invertPositive(kT1);
-    row.massT2 = invertPositive(kT2);
-    row.approachVelocity = relativeVelocity(bodies, row).dot(row.normal);
-  }
+Softness<S> makeSoftness(S hertz, S zeta, S h, S pi) {
+  if (!(hertz > S(0))) return Softness<S>{S(0), S(1), S(0)};
+  const S omega = S(2) * pi * hertz;
+  const S a1 = S(2) * zeta + h * omega;
+  const S a2 = h * omega * a1;
+  const S a3 = S(1) / (S(1) + a2);
+  return Softness<S>{omega / a1, a2 * a3, a3};
 }
 
+namespace {
+
+/// Last tick's impulses for each row: the same key first, then the nearest point of the same
+/// body pair within 1 cm; every cached entry serves at most one contact.
 template <class S>
-void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
-                            std::vector<ContactRow<S>>& rows, const SolverSettings<S>& settings,
-                            std::vector<CachedImpulse<S>>& cache) {
-  // Warm start, in two passes so every cached entry serves at most one contact: first the
-  // contacts whose key (bodies and features) is unchanged, then the others by nearest point.
+void matchCachedImpulses(const std::vector<Contact<S>>& contacts, const std::vector<CachedImpulse<S>>& cache,
+                         std::vector<ContactRow<S>>& rows) {
   std::vector<uint8_t> used(cache.size(), 0);
   std::vector<size_t> match(rows.size(), cache.size());
   for (size_t i = 0; i < rows.size(); ++i) {
@@ -150,54 +125,170 @@ void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector
   }
   for (size_t i = 0; i < rows.size(); ++i) {
     if (match[i] == cache.size()) continue;
-    ContactRow<S>& row = rows[i];
     const CachedImpulse<S>& hit = cache[match[i]];
-    row.impulseN = hit.normal;
-    row.impulseT1 = hit.tangent1;
-    row.impulseT2 = hit.tangent2;
-    applyPair(bodies, row, Vec3<S>(row.normal * row.impulseN + row.t1 * row.impulseT1 + row.t2 * row.impulseT2));
+    rows[i].impulseN = hit.normal;
+    rows[i].impulseT1 = hit.tangent1;
+    rows[i].impulseT2 = hit.tangent2;
   }
-  for (int it = 0; it < settings.velocityIterations; ++it) {
-    for (ContactRow<S>& row : rows) {
-      // Normal: push apart until the bodies stop closing; never pull.
-      const S vn = relativeVelocity(bodies, row).dot(row.normal);
-      S lambda = -vn * row.massN;
-      const S total = maxS(row.impulseN + lambda, S(0));
-      lambda = total - row.impulseN;
-      row.impulseN = total;
-      applyPair(bodies, row, Vec3<S>(row.normal * lambda));
-      // Friction: stop the sliding velocity, within the Coulomb cone mu * normal impulse.
-      const S limit = row.friction * row.impulseN;
-      for (int t = 0; t < 2; ++t) {
-        const Vec3<S>& dir = t == 0 ? row.t1 : row.t2;
-        S& accumulated = t == 0 ? row.impulseT1 : row.impulseT2;
-        const S vt = relativeVelocity(bodies, row).dot(dir);
-        const S wanted = accumulated - vt * (t == 0 ? row.massT1 : row.massT2);
-        const S clamped = wanted < -limit ? -limit : (wanted > limit ? limit : wanted);
-        const S delta = clamped - accumulated;
-        accumulated = clamped;
-        applyPair(bodies, row, Vec3<S>(dir * delta));
-      }
+}
+
+/// A's anchor minus B's anchor in the world now. The terrain does not move: its anchor is a
+/// constant that cancels against ContactRow::anchorGap, so it is left out.
+template <class S>
+Vec3<S> anchorDifference(const std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row) {
+  const RigidBody<S>& A = bodies[size_t(row.a)];
+  const Vec3<S> d = A.position + A.rotation * row.localA;
+  if (row.b == kTerrainBody) return d;
+  const RigidBody<S>& B = bodies[size_t(row.b)];
+  return d - (B.position + B.rotation * row.localB);
+}
+
+}  // namespace
+
+template <class S>
+void prepareContacts(const std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
+                     const std::vector<CachedImpulse<S>>& cache, std::vector<ContactRow<S>>& rows) {
+  using std::sqrt;
+  rows.assign(contacts.size(), ContactRow<S>{});
+  for (size_t i = 0; i < contacts.size(); ++i) {
+    const Contact<S>& c = contacts[i];
+    ContactRow<S>& row = rows[i];
+    row.a = c.bodyA;
+    row.b = c.bodyB;
+    const RigidBody<S>& A = bodies[size_t(c.bodyA)];
+    row.rA = c.point - A.position;
+    row.localA = A.rotation.transpose() * row.rA;
+    row.normal = c.normal;
+    row.t1 = tangentOf(c.normal);
+    row.t2 = c.normal.cross(row.t1);
+    row.separation = -c.penetration;
+    S kN = inverseMassAlong(A, row.rA, row.normal);
+    S kT1 = inverseMassAlong(A, row.rA, row.t1);
+    S kT2 = inverseMassAlong(A, row.rA, row.t2);
+    row.restitution = A.restitution;
+    row.friction = A.friction;
+    if (c.bodyB != kTerrainBody) {
+      const RigidBody<S>& B = bodies[size_t(c.bodyB)];
+      row.rB = c.point - B.position;
+      row.localB = B.rotation.transpose() * row.rB;
+      kN += inverseMassAlong(B, row.rB, row.normal);
+      kT1 += inverseMassAlong(B, row.rB, row.t1);
+      kT2 += inverseMassAlong(B, row.rB, row.t2);
+      row.restitution = A.restitution < B.restitution ? B.restitution : A.restitution;
+      row.friction = sqrt(A.friction * B.friction);
+    }
+    row.anchorGap = anchorDifference(bodies, row);  // the separation's reference: s is exact at prepare
+    row.massN = invertPositive(kN);
+    row.massT1 = invertPositive(kT1);
+    row.massT2 = invertPositive(kT2);
+  }
+  matchCachedImpulses(contacts, cache, rows);
+}
+
+template <class S>
+void warmStartContacts(std::vector<RigidBody<S>>& bodies, const std::vector<ContactRow<S>>& rows) {
+  for (const ContactRow<S>& row : rows)
+    applyPair(bodies, row, Vec3<S>(row.normal * row.impulseN + row.t1 * row.impulseT1 + row.t2 * row.impulseT2));
+}
+
+template <class S>
+void solveContacts(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows,
+                   const SolverSettings<S>& settings, bool useBias) {
+  for (ContactRow<S>& row : rows) {
+    // The separation now: the anchors moved with their bodies since prepare.
+    const S s = row.separation + (anchorDifference(bodies, row) - row.anchorGap).dot(row.normal);
+    S bias(0), massScale(1), impulseScale(0);
+    if (s > S(0)) {
+      // Speculative: close at most the gap in this sub-step. Only in the solve, which the
+      // position integration follows; in the relax it would act on the *next* sub-step's motion
+      // (a ball 2 cm above the ground at the tick's end bounced there, a centimetre early, and
+      // lost m g x that gap of energy per bounce).
+      if (!useBias) continue;
+      bias = s * settings.invSubstep;
+    } else if (useBias) {
+      const Softness<S>& soft = row.b == kTerrainBody ? settings.staticSoftness : settings.bodySoftness;
+      bias = maxS(soft.biasRate * s, -settings.maxPushVelocity);
+      massScale = soft.massScale;
+      impulseScale = soft.impulseScale;
+    }
+    // Normal: push apart until the bodies stop closing (faster than the bias allows); never pull.
+    const S vn = relativeVelocity(bodies, row).dot(row.normal);
+    S lambda = -row.massN * massScale * (vn + bias) - impulseScale * row.impulseN;
+    const S total = maxS(row.impulseN + lambda, S(0));
+    lambda = total - row.impulseN;
+    row.impulseN = total;
+    // The fastest approach any push met. Not just the first: a ball that left the ground at V
+    // comes back down through the same discrete positions (the integrator is time-reversible)
+    // and lands exactly on the surface, where rounding makes a push of ~1e-16 one sub-step
+    // before the real one; taking that approach (V - g h) lost g h of speed per bounce.
+    if (total > S(0) && vn < row.impactVelocity) {
+      row.impactVelocity = vn;
+      row.impactGap = maxS(s, S(0));
+    }
+    row.maxImpulseN = maxS(row.maxImpulseN, total);
+
+    applyPair(bodies, row, Vec3<S>(row.normal * lambda));
+    // Friction: stop the sliding velocity, within the Coulomb cone mu * normal impulse.
+    const S limit = row.friction * row.impulseN;
+    for (int t = 0; t < 2; ++t) {
+      const Vec3<S>& dir = t == 0 ? row.t1 : row.t2;
+      S& accumulated = t == 0 ? row.impulseT1 : row.impulseT2;
+      const S vt = relativeVelocity(bodies, row).dot(dir);
+      const S wanted = accumulated - vt * (t == 0 ? row.massT1 : row.massT2);
+      const S clamped = wanted < -limit ? -limit : (wanted > limit ? limit : wanted);
+      const S delta = clamped - accumulated;
+      accumulated = clamped;
+      applyPair(bodies, row, Vec3<S>(dir * delta));
     }
   }
-  // Restitution: against the approach velocity measured before gravity and the solve, and only
-  // where the contact pushed (a contact that merely grazed bounces nothing).
+}
+
+template <class S>
+void applyRestitution(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows,
+                      const SolverSettings<S>& settings) {
+  // Against the normal velocity the contact met when it first pushed (before that sub-step's
+  // solve), and only where it pushed (a contact that merely grazed bounces nothing).
   for (ContactRow<S>& row : rows) {
-    if (!(row.approachVelocity < -settings.restitutionThreshold) || !(row.impulseN > S(0))) continue;
+    if (!(row.maxImpulseN > S(0)) || !(row.impactVelocity < -settings.restitutionThreshold)) continue;
+    if (row.restitution == S(0)) continue;
+    // A speculative push stopped the body `impactGap` short of where it would have met the
+    // surface (it then rests on it for the rest of the tick): against the terrain, gravity
+    // would have sped it up over that gap, so the impact speed gets the gain of
+    // v^2 = V^2 + 2 g_n gap (first order: V + g_n gap / V; gap <= V h keeps the neglected term
+    // below (g h / V)^2 / 2, 0.4 % at the 1 m/s threshold and 60 Hz x 4). Without it an elastic
+    // ball lost m g_n gap, half a sub-step of fall on average, every bounce (a third of its height
+    // in a minute). Between two bodies gravity pulls both alike: no relative gain.
+    S impactSpeed = -row.impactVelocity;
+    if (row.b == kTerrainBody && row.impactGap > S(0)) {
+      const S pull = -settings.gravity.dot(row.normal);  // m/s^2 towards the surface
+      if (pull > S(0)) impactSpeed += pull * row.impactGap / impactSpeed;
+    }
     const S vn = relativeVelocity(bodies, row).dot(row.normal);
-    S lambda = -(vn + row.restitution * row.approachVelocity) * row.massN;
+    S lambda = -(vn - row.restitution * impactSpeed) * row.massN;
     const S total = maxS(row.impulseN + lambda, S(0));
     lambda = total - row.impulseN;
     row.impulseN = total;
     applyPair(bodies, row, Vec3<S>(row.normal * lambda));
   }
+}
+
+template <class S>
+void storeImpulses(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
+                   const std::vector<ContactRow<S>>& rows, const SolverSettings<S>& settings,
+                   std::vector<CachedImpulse<S>>& cache) {
   // Sliding: a body whose contacts' friction, summed, reached the summed Coulomb limits (a
   // tangent impulse at +-mu x normal impulse is saturated). Such a body is not held by its
   // contacts: a box a quarter degree past its friction angle accelerates at 4 cm/s^2, slow enough
   // for the speed test, yet it must slide on. Summed per body, not per contact: one corner of a
   // resting box may saturate while the others hold it (fx16 rounding did that).
+  // Overlapping deeper than the slop: still being pushed out, however small its velocity.
   std::vector<S> friction(bodies.size(), S(0)), limit(bodies.size(), S(0));
+  std::vector<uint8_t> deep(bodies.size(), 0);
   for (const ContactRow<S>& row : rows) {
+    if (row.separation < -settings.linearSlop) {
+      deep[size_t(row.a)] = 1;
+      if (row.b != kTerrainBody) deep[size_t(row.b)] = 1;
+    }
     const S used = maxS(abs(row.impulseT1), abs(row.impulseT2));
     const S most = row.friction * row.impulseN;
     for (const int32_t id : {row.a, row.b}) {
@@ -206,96 +297,28 @@ void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector
       limit[size_t(id)] += most;
     }
   }
-  for (size_t i = 0; i < bodies.size(); ++i) bodies[i].slidingThisTick = limit[i] > S(0) && !(friction[i] < limit[i]);
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    const bool sliding = limit[i] > S(0) && !(friction[i] < limit[i]);
+    bodies[i].heldThisTick = !sliding && !deep[i];
+  }
   cache.clear();
   for (size_t i = 0; i < rows.size(); ++i)
     cache.push_back(CachedImpulse<S>{contacts[i].bodyA, contacts[i].bodyB, contacts[i].featureA, contacts[i].featureB,
                                      rows[i].impulseN, rows[i].impulseT1, rows[i].impulseT2, contacts[i].point});
 }
 
-template <class S>
-void solveContactPositions(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
-                           const std::vector<ContactRow<S>>& rows, S dt, const SolverSettings<S>& settings) {
-  const size_t n = contacts.size();
-  if (n == 0) return;
-  std::vector<S> depth(n);
-  for (size_t i = 0; i < n; ++i) {
-    const S separating = maxS(relativeVelocity(bodies, rows[i]).dot(rows[i].normal), S(0));
-    depth[i] = contacts[i].penetration - separating * dt;  // what integration will not remove
-  }
-  const size_t iterations = size_t(settings.positionIterationsPerContact) * n;
-  for (size_t it = 0; it < iterations; ++it) {
-    // The deepest contact first (lowest index on ties: canonical order).
-    size_t worst = n;
-    S deepest = settings.linearSlop;
-    for (size_t i = 0; i < n; ++i)
-      if (depth[i] > deepest) {
-        deepest = depth[i];
-        worst = i;
-      }
-    if (worst == n) break;
-    const Contact<S>& c = contacts[worst];
-    const Vec3<S>& normal = c.normal;
-    // Leave `linearSlop` of overlap (Box2D): the contact then still exists next tick, so a resting
-    // body keeps its support instead of falling g dt^2 and being pushed back every other tick.
-    deepest -= settings.linearSlop;
-    const int32_t ids[2] = {c.bodyA, c.bodyB};
-    const Vec3<S>* arms[2] = {&rows[worst].rA, &rows[worst].rB};  // the arms the velocity pass used
-    S linearInertia[2] = {S(0), S(0)}, angularInertia[2] = {S(0), S(0)};
-    Vec3<S> angularPerUnit[2] = {Vec3<S>::Zero(), Vec3<S>::Zero()};
-    S totalInertia(0);
-    for (int k = 0; k < 2; ++k) {
-      if (ids[k] == kTerrainBody) continue;
-      const RigidBody<S>& body = bodies[size_t(ids[k])];
-      angularPerUnit[k] = body.invInertiaWorld * arms[k]->cross(normal);
-      angularInertia[k] = angularPerUnit[k].cross(*arms[k]).dot(normal);
-      linearInertia[k] = body.invMass;
-      totalInertia += linearInertia[k] + angularInertia[k];
-    }
-    if (!(totalInertia > S(0))) {
-      depth[worst] = S(0);
-      continue;
-    }
-    for (int k = 0; k < 2; ++k) {
-      if (ids[k] == kTerrainBody) continue;
-      RigidBody<S>& body = bodies[size_t(ids[k])];
-      const S sign = k == 0 ? S(1) : S(-1);
-      S linearMove = sign * deepest * linearInertia[k] / totalInertia;
-      S angularMove = sign * deepest * angularInertia[k] / totalInertia;
-      // Cyclone: rotating by more than 0.2 |r| per step overshoots; move linearly instead.
-      const S limit = arms[k]->norm() / S(5);
-      if (abs(angularMove) > limit) {
-        const S both = linearMove + angularMove;
-        angularMove = angularMove < S(0) ? -limit : limit;
-        linearMove = both - angularMove;
-      }
-      const Vec3<S> dp = normal * linearMove;
-      const Vec3<S> dTheta = angularInertia[k] > S(0) ? Vec3<S>(angularPerUnit[k] * (angularMove / angularInertia[k]))
-                                                      : Vec3<S>(Vec3<S>::Zero());
-      body.position += dp;
-      const Quat<S> spin(S(0), dTheta.x(), dTheta.y(), dTheta.z());
-      Quat<S> q = body.orientation;
-      q.coeffs() += (spin * body.orientation).coeffs() / S(2);
-      body.orientation = normalizedQuat(q);
-      body.updateDerived();
-      // Every contact of this body loses (or gains) the depth this move removed.
-      for (size_t i = 0; i < n; ++i) {
-        if (contacts[i].bodyA == ids[k]) depth[i] -= (dp + dTheta.cross(rows[i].rA)).dot(contacts[i].normal);
-        if (contacts[i].bodyB == ids[k]) depth[i] += (dp + dTheta.cross(rows[i].rB)).dot(contacts[i].normal);
-      }
-    }
-  }
-}
-
-#define SG_INSTANTIATE(S)                                                                            \
-  template void sortContacts(std::vector<Contact<S>>&);                                              \
-  template void prepareContactRows(const std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&, \
-                                   std::vector<ContactRow<S>>&);                                     \
-  template void solveContactVelocities(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&,   \
-                                       std::vector<ContactRow<S>>&, const SolverSettings<S>&,        \
-                                       std::vector<CachedImpulse<S>>&);                              \
-  template void solveContactPositions(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&,    \
-                                      const std::vector<ContactRow<S>>&, S, const SolverSettings<S>&);
+#define SG_INSTANTIATE(S)                                                                                            \
+  template Softness<S> makeSoftness(S, S, S, S);                                                                     \
+  template void sortContacts(std::vector<Contact<S>>&);                                                              \
+  template void prepareContacts(const std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&,                    \
+                                const std::vector<CachedImpulse<S>>&, std::vector<ContactRow<S>>&);                  \
+  template void warmStartContacts(std::vector<RigidBody<S>>&, const std::vector<ContactRow<S>>&);                    \
+  template void solveContacts(std::vector<RigidBody<S>>&, std::vector<ContactRow<S>>&, const SolverSettings<S>&,     \
+                              bool);                                                                                 \
+  template void applyRestitution(std::vector<RigidBody<S>>&, std::vector<ContactRow<S>>&, const SolverSettings<S>&); \
+  template void storeImpulses(std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&,                            \
+                              const std::vector<ContactRow<S>>&, const SolverSettings<S>&,                           \
+                              std::vector<CachedImpulse<S>>&);
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE)
 #undef SG_INSTANTIATE
 }  // namespace sg

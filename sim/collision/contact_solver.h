@@ -1,24 +1,40 @@
-// Collision response for rigid bodies (thesis §7, Cyclone; the restitution pass after Box2D v3):
-//   0. prepare: each contact's arms, directions and effective masses, and its normal relative
-//      velocity *before* this tick's gravity (`approachVelocity`). Restitution is measured
-//      against it: the velocity after gravity was taken by a ball already inside the ground, so
-//      reflecting it returned g dt more speed than arrived, every bounce (a ball with e = 1
-//      dropped from 2 m rose to 6.8 m in a minute at 60 Hz).
-//   1. velocities: sequential impulses over all contacts, `velocityIterations` sweeps, with
-//      accumulated normal impulses kept >= 0 and a separating-velocity target of 0; Coulomb
-//      friction on two tangents, accumulated and clamped to mu * normal impulse (the thesis
-//      leaves friction out; a testbed needs it).
-//   2. restitution, one pass after the solve (Box2D v3's b2ApplyRestitution): a contact that
-//      approached faster than `restitutionThreshold` and pushed (normal impulse > 0) takes the
-//      impulse that makes its separating velocity e times the approach velocity.
-//   3. positions: Cyclone's non-linear projection, down to `linearSlop` of overlap (so resting
-//      contacts persist from tick to tick). Repeatedly take the deepest contact, move both
-//      bodies linearly and angularly in proportion to their inverse mass and inverse angular
-//      inertia about the contact, limit the angular part to 0.2 |r| per step, and update the
-//      penetration of every other contact of the moved bodies. It moves positions only: it
-//      never feeds velocity.
-// Contacts are sorted canonically (bodies, then features) before solving, so the result never
-// depends on how the narrow phase found them.
+// Contact solver for rigid bodies: a soft step after Box2D v3 (b2SolverStage in solver.c,
+// contact_solver.c), written for 3D, fixed point and one deterministic sequence. One tick of dt
+// is `substeps` sub-steps of h = dt / substeps; the world runs, in order (world_contacts.cpp):
+//   prepare   (once)  each contact's arms, effective masses, body-frame anchors and separation;
+//                     last tick's impulses by contact key (warm starting);
+//   per sub-step:     gravity and the gyroscopic term (h); warm start (apply the accumulated
+//                     impulses); solve with soft bias; integrate positions (h); relax without
+//                     bias;
+//   store (once)      the impulses, keyed, for the next tick (before restitution: the next tick
+//                     warm-starts with the resting impulse, not the one-off bounce); which
+//                     bodies slid;
+//   restitution (once) a contact that pushed against an approach faster than
+//                     `restitutionThreshold` takes the impulse that makes its separating velocity
+//                     e times that approach (b2ApplyRestitution). The approach is the normal
+//                     velocity the pushing solves met, before their impulse: after the gravity
+//                     of that sub-step only (measured after the whole tick's gravity, with the
+//                     body already in the ground, each bounce gained g dt: 2 m became 6.8 m in
+//                     a minute).
+//
+// Why this design (it replaced sequential impulses plus Cyclone's position projection):
+//   * Soft contacts (a spring-damper of `contactHertz`, damping ratio `contactDampingRatio`, as
+//     an implicit soft constraint) push overlap out at a bounded speed (`contactPushMaxVelocity`)
+//     and the relax pass then removes that push velocity: position correction never feeds
+//     velocity, so it cannot add energy (the projection moved positions only, but its
+//     overshoots and re-contacts did).
+//   * Sub-steps: the stack and mass-ratio error of Gauss-Seidel falls with the step size
+//     squared, so 4 sub-steps of 1 iteration beat 16 iterations of one step (Box2D's result:
+//     a 20-box stack stands at defaults, where the old solver needed 128 iterations).
+//   * The current separation is recomputed from the bodies' moved anchors in every iteration, so
+//     a sub-step solves the positions it has, not those of the tick's start.
+//   * Speculative contacts: a contact of positive separation s (the narrow phase reports shapes
+//     up to the speculative distance plus the tick's motion apart) lets the bodies close by at
+//     most s within a sub-step (bias s / h). A body fast enough to pass through a wall in one
+//     tick stops at its surface: continuous collision without a time-of-impact search.
+// Contacts are solved in their canonical order (bodies, then features): the same bits for any
+// broad phase and thread count. Box2D colours the constraint graph to solve it in parallel; a
+// sequential solve in canonical order needs no colouring and converges as well.
 #pragma once
 
 #include <vector>
@@ -28,22 +44,42 @@
 
 namespace sg {
 
+/// An implicit soft constraint's coefficients for one sub-step h (Box2D's b2Softness): with
+/// omega = 2 pi hertz, a1 = 2 zeta + h omega, a2 = h omega a1, a3 = 1 / (1 + a2):
+/// biasRate = omega / a1 (1/s), massScale = a2 a3, impulseScale = a3.
+template <class S>
+struct Softness {
+  S biasRate{};
+  S massScale{1};
+  S impulseScale{};
+};
+
+/// The soft coefficients for a spring of `hertz` and damping ratio `zeta` over a sub-step h (s);
+/// `pi` is pi in S. hertz 0 gives a rigid constraint without bias.
+template <class S>
+Softness<S> makeSoftness(S hertz, S zeta, S h, S pi);
+
 template <class S>
 struct SolverSettings {
-  int velocityIterations = 8;
-  int positionIterationsPerContact = 8;  // the scenario's bodies.positionIterations default
-  S restitutionThreshold{};              ///< m/s
-  S linearSlop{};                        ///< m: penetration the position pass leaves alone
+  int substeps = 4;                   ///< sub-steps per tick (the scenario's bodies.substeps)
+  int solveIterations = 1;            ///< solve sweeps per sub-step (bodies.velocityIterations)
+  int relaxIterations = 1;            ///< relax sweeps per sub-step (bodies.positionIterations)
+  S restitutionThreshold{};           ///< m/s
+  S maxPushVelocity{};                ///< m/s: the fastest a soft contact pushes overlap out
+  S linearSlop{};                     ///< m: deeper overlap keeps a body awake (settings::kLinearSlop)
+  S invSubstep{};                     ///< 1/s: 1 / h
+  Vec3<S> gravity = Vec3<S>::Zero();  ///< m/s^2 (restitution's speculative-gap gain)
+  Softness<S> bodySoftness;           ///< body against body
+  Softness<S> staticSoftness;         ///< body against the terrain: twice as stiff (Box2D)
 };
 
 /// Sorts contacts into their canonical order (bodyA, bodyB, featureA, featureB).
 template <class S>
 void sortContacts(std::vector<Contact<S>>& contacts);
 
-/// The accumulated impulses of one contact at the end of a tick, keyed by its canonical identity
-/// (bodies and features). The next tick starts from them (warm starting, as Box2D and Jolt do):
-/// without it, sequential impulses need many more iterations and a stack leans and falls.
-/// Part of the world state (saved, restored, hashed).
+/// The accumulated impulses of one contact at the end of a tick (per sub-step), keyed by its
+/// canonical identity (bodies and features). The next tick starts from them (warm starting, as
+/// Box2D and Jolt do). Part of the world state (saved, restored, hashed).
 template <class S>
 struct CachedImpulse {
   int32_t bodyA = 0, bodyB = kTerrainBody;
@@ -53,41 +89,52 @@ struct CachedImpulse {
   friend bool operator==(const CachedImpulse&, const CachedImpulse&) = default;
 };
 
-/// One contact as the velocity solver sees it (one row of the normal and two friction
-/// constraints).
+/// One contact as the solver sees it (one normal and two friction rows).
 template <class S>
 struct ContactRow {
-  Vec3<S> rA, rB;  ///< m: contact point relative to the centres of mass
+  Vec3<S> rA, rB;          ///< m: contact point relative to the centres of mass at the tick's start (velocity arms)
+  Vec3<S> localA, localB;  ///< m: the same arms in each body's frame (they turn with the body)
+  Vec3<S> anchorGap;       ///< m: A's anchor - B's anchor (terrain: A's alone) at prepare; s starts exact
   Vec3<S> normal, t1, t2;
+  S separation{};                 ///< m at prepare: minus the penetration (> 0: speculative)
   S massN{}, massT1{}, massT2{};  ///< kg: 1 / effective inverse mass along each direction
-  S approachVelocity{};           ///< m/s: normal relative velocity before this tick's gravity (< 0: closing)
+  S impactVelocity{};             ///< m/s: the most negative normal velocity a pushing solve met this tick
+  S impactGap{};                  ///< m: the separation (>= 0) when it did (a speculative stop short of the surface)
   S restitution{}, friction{};
-  S impulseN{}, impulseT1{}, impulseT2{};  ///< N s, accumulated
+  S impulseN{}, impulseT1{}, impulseT2{};  ///< N s per sub-step, accumulated
+  S maxImpulseN{};                         ///< the largest normal impulse of any sub-step (did it push?)
   int32_t a = 0, b = kTerrainBody;
 };
 
-/// Builds the rows of `contacts` from the bodies as they are before this tick's gravity (stage 0).
+/// Builds the rows of `contacts` from the bodies as they are before this tick's gravity, and
+/// takes each contact's impulses from `cache` (last tick's, sorted by key): the entry of the same
+/// key, or else the nearest cached point of the same body pair within 1 cm (two coplanar box faces
+/// swap clipping features from tick to tick, and losing their impulses makes a stack walk).
 template <class S>
-void prepareContactRows(const std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
-                        std::vector<ContactRow<S>>& rows);
+void prepareContacts(const std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
+                     const std::vector<CachedImpulse<S>>& cache, std::vector<ContactRow<S>>& rows);
 
-/// Solves velocities (stages 1 and 2); `cache` holds last tick's impulses (sorted by key) and is
-/// replaced by this tick's. A contact takes the cached impulses of the same key, or else of the
-/// nearest cached contact point of the same body pair within 1 cm: two coplanar box faces swap
-/// clipping features from tick to tick (a corner exactly on a side plane), and losing their
-/// impulses makes a stack walk.
+/// Applies every row's accumulated impulses (the start of each sub-step).
 template <class S>
-void solveContactVelocities(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
-                            std::vector<ContactRow<S>>& rows, const SolverSettings<S>& settings,
-                            std::vector<CachedImpulse<S>>& cache);
+void warmStartContacts(std::vector<RigidBody<S>>& bodies, const std::vector<ContactRow<S>>& rows);
 
-/// Stage 3. A contact separating at vn > 0 after the velocity solve loses vn dt of its overlap in
-/// this tick's integration by itself: the projection removes only the rest. Projecting the whole
-/// overlap of a bouncing contact counted that separation twice and lifted the body by up to
-/// u dt per bounce, potential energy from nowhere (a ball with e = 0.9 settled into endless
-/// 5 cm hops at the 1 m/s restitution threshold instead of coming to rest).
+/// One sweep over all rows: the normal (soft when `useBias`; speculative rows always limit the
+/// approach to their current gap per sub-step), then Coulomb friction on two tangents within
+/// mu x normal impulse.
 template <class S>
-void solveContactPositions(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
-                           const std::vector<ContactRow<S>>& rows, S dt, const SolverSettings<S>& settings);
+void solveContacts(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows,
+                   const SolverSettings<S>& settings, bool useBias);
+
+/// After the sub-steps: restitution against the impact velocity, where the contact pushed.
+template <class S>
+void applyRestitution(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows,
+                      const SolverSettings<S>& settings);
+
+/// Replaces `cache` by this tick's impulses and marks the bodies whose contacts slid or overlap
+/// by more than the slop (RigidBody::heldThisTick false).
+template <class S>
+void storeImpulses(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
+                   const std::vector<ContactRow<S>>& rows, const SolverSettings<S>& settings,
+                   std::vector<CachedImpulse<S>>& cache);
 
 }  // namespace sg

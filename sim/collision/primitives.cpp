@@ -4,28 +4,33 @@ namespace sg {
 
 template <class S>
 int collideSphereSphere(int32_t a, const Vec3<S>& ca, S ra, int32_t b, const Vec3<S>& cb, S rb,
-                        std::vector<Contact<S>>& out) {
+                        std::vector<Contact<S>>& out, S speculative) {
   const Vec3<S> d = ca - cb;
   const S reach = ra + rb;
+  const S detect = reach + speculative;
   // Cheap reject on each axis before squaring (keeps fx16 products small).
-  if (abs(d.x()) >= reach || abs(d.y()) >= reach || abs(d.z()) >= reach) return 0;
+  if (abs(d.x()) >= detect || abs(d.y()) >= detect || abs(d.z()) >= detect) return 0;
   const S dist = length3(d.x(), d.y(), d.z());
-  if (dist >= reach) return 0;
+  if (dist >= detect) return 0;
   Contact<S> c;
   c.bodyA = a;
   c.bodyB = b;
   c.normal = dist == S(0) ? Vec3<S>::UnitY() : Vec3<S>(d / dist);
   c.penetration = reach - dist;
-  c.point = cb + c.normal * (rb - c.penetration / S(2));
+  // Overlapping: midway between the surfaces. Speculative: on A's surface, so the arms stay the
+  // size of the sphere however wide the gap (a long arm is a huge angular term, and overflows fx16).
+  c.point = c.penetration < S(0) ? Vec3<S>(ca - c.normal * ra) : Vec3<S>(cb + c.normal * (rb - c.penetration / S(2)));
   out.push_back(c);
   return 1;
 }
 
 template <class S>
 int collideSphereBox(int32_t a, const Vec3<S>& ca, S ra, int32_t b, const Vec3<S>& hb, const Pose<S>& pb,
-                     std::vector<Contact<S>>& out) {
+                     std::vector<Contact<S>>& out, S speculative) {
   const Vec3<S> local = pb.toLocal(ca);
-  if (abs(local.x()) >= hb.x() + ra || abs(local.y()) >= hb.y() + ra || abs(local.z()) >= hb.z() + ra) return 0;
+  const S detect = ra + speculative;
+  if (abs(local.x()) >= hb.x() + detect || abs(local.y()) >= hb.y() + detect || abs(local.z()) >= hb.z() + detect)
+    return 0;
   Vec3<S> closest;
   for (int i = 0; i < 3; ++i) closest[i] = local[i] < -hb[i] ? -hb[i] : (local[i] > hb[i] ? hb[i] : local[i]);
   Contact<S> c;
@@ -45,10 +50,10 @@ int collideSphereBox(int32_t a, const Vec3<S>& ca, S ra, int32_t b, const Vec3<S
   } else {
     const Vec3<S> d = local - closest;
     const S dist = length3(d.x(), d.y(), d.z());
-    if (dist >= ra) return 0;
+    if (dist >= detect) return 0;
     c.normal = pb.rotation * Vec3<S>(d / dist);  // dist > 0: the centre is outside
     c.penetration = ra - dist;
-    c.point = pb.toWorld(closest);
+    c.point = dist > ra ? Vec3<S>(ca - c.normal * ra) : pb.toWorld(closest);  // speculative: on the sphere
     c.featureB = 6;
   }
   out.push_back(c);
@@ -56,27 +61,28 @@ int collideSphereBox(int32_t a, const Vec3<S>& ca, S ra, int32_t b, const Vec3<S
 }
 
 template <class S>
-int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& terrain, std::vector<Contact<S>>& out) {
+int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& terrain, std::vector<Contact<S>>& out,
+                         S speculative) {
   const S h = terrain.heightAt(ca.x(), ca.z());
-  if (ca.y() - h >= ra + ra) return 0;  // far above: not even a steep slope can touch
+  if (ca.y() - h >= ra + ra + speculative) return 0;  // far above: not even a steep slope can touch
   Vec3<S> n;
   terrain.normalAt(ca.x(), ca.z(), &n.x(), &n.y(), &n.z());
   // Distance from the centre to the tangent plane through (x, h, z).
   const S dist = (ca.y() - h) * n.y();
-  if (dist >= ra) return 0;
+  if (dist >= ra + speculative) return 0;
   Contact<S> c;
   c.bodyA = a;
   c.bodyB = kTerrainBody;
   c.normal = n;
   c.penetration = ra - dist;
-  c.point = ca - n * dist;
+  c.point = ca - n * minS(dist, ra);  // speculative: the sphere's lowest point, not the ground far below
   out.push_back(c);
   return 1;
 }
 
 template <class S>
 int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Terrain<S>& terrain,
-                      std::vector<Contact<S>>& out) {
+                      std::vector<Contact<S>>& out, S speculative) {
   int added = 0;
   // 1. Corners below the terrain (thesis).
   for (uint32_t corner = 0; corner < 8; ++corner) {
@@ -84,7 +90,7 @@ int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Ter
                         (corner & 4) ? ha.z() : -ha.z());
     const Vec3<S> p = pa.toWorld(local);
     const S h = terrain.heightAt(p.x(), p.z());
-    if (p.y() >= h) continue;
+    if (p.y() - h >= speculative) continue;  // the vertical gap bounds the gap along the normal
     Vec3<S> n;
     terrain.normalAt(p.x(), p.z(), &n.x(), &n.y(), &n.z());
     Contact<S> c;
@@ -122,12 +128,14 @@ int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Ter
   return added;
 }
 
-#define SG_INSTANTIATE(S)                                                                                             \
-  template int collideSphereSphere(int32_t, const Vec3<S>&, S, int32_t, const Vec3<S>&, S, std::vector<Contact<S>>&); \
-  template int collideSphereBox(int32_t, const Vec3<S>&, S, int32_t, const Vec3<S>&, const Pose<S>&,                  \
-                                std::vector<Contact<S>>&);                                                            \
-  template int collideSphereTerrain(int32_t, const Vec3<S>&, S, const Terrain<S>&, std::vector<Contact<S>>&);         \
-  template int collideBoxTerrain(int32_t, const Vec3<S>&, const Pose<S>&, const Terrain<S>&, std::vector<Contact<S>>&);
+#define SG_INSTANTIATE(S)                                                                                              \
+  template int collideSphereSphere(int32_t, const Vec3<S>&, S, int32_t, const Vec3<S>&, S, std::vector<Contact<S>>&,   \
+                                   S);                                                                                 \
+  template int collideSphereBox(int32_t, const Vec3<S>&, S, int32_t, const Vec3<S>&, const Pose<S>&,                   \
+                                std::vector<Contact<S>>&, S);                                                          \
+  template int collideSphereTerrain(int32_t, const Vec3<S>&, S, const Terrain<S>&, std::vector<Contact<S>>&, S);       \
+  template int collideBoxTerrain(int32_t, const Vec3<S>&, const Pose<S>&, const Terrain<S>&, std::vector<Contact<S>>&, \
+                                 S);
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE)
 #undef SG_INSTANTIATE
 }  // namespace sg

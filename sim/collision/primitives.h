@@ -1,6 +1,10 @@
 // Narrow phase for spheres and against the terrain (thesis §4 "Collision detection"). Box-box is
 // in box_box.h. Every routine appends contacts with the conventions of contact.h (normal from B
-// to A, penetration > 0) and never divides by zero: coincident centres get a fixed normal.
+// to A) and never divides by zero: coincident centres get a fixed normal.
+// `speculative` (m, >= 0): shapes up to that far apart get a contact too, with a negative
+// penetration (the gap). The solver lets such a contact close at most its gap per step
+// (speculative contacts, Box2D v3), so a body that would pass through within a tick stops at the
+// surface instead; the world sets it from the bodies' speeds (sim/collision/world_contacts.cpp).
 #pragma once
 
 #include <vector>
@@ -13,23 +17,25 @@ namespace sg {
 /// Sphere A (centre ca, radius ra) against sphere B.
 template <class S>
 int collideSphereSphere(int32_t a, const Vec3<S>& ca, S ra, int32_t b, const Vec3<S>& cb, S rb,
-                        std::vector<Contact<S>>& out);
+                        std::vector<Contact<S>>& out, S speculative = S(0));
 
 /// Sphere A against box B (half extents hb, pose pb). Closest point on the box in box space;
 /// a centre inside the box is pushed out through the nearest face.
 template <class S>
 int collideSphereBox(int32_t a, const Vec3<S>& ca, S ra, int32_t b, const Vec3<S>& hb, const Pose<S>& pb,
-                     std::vector<Contact<S>>& out);
+                     std::vector<Contact<S>>& out, S speculative = S(0));
 
 /// Sphere A against the terrain: the terrain plane under the centre (height and normal there).
 template <class S>
-int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& terrain, std::vector<Contact<S>>& out);
+int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& terrain, std::vector<Contact<S>>& out,
+                         S speculative = S(0));
 
 /// Box A against the terrain. The thesis tested the eight corners against the height under them;
 /// that lets a box sink through a ridge between its corners, so heightmap samples under the box
 /// footprint that lie inside the box are contacts too (pushed out through the nearest face).
+/// Corners up to `speculative` above the terrain are speculative contacts; samples only overlap.
 template <class S>
 int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Terrain<S>& terrain,
-                      std::vector<Contact<S>>& out);
+                      std::vector<Contact<S>>& out, S speculative = S(0));
 
 }  // namespace sg

@@ -1,6 +1,8 @@
 // The body stages of World<S>: collision detection (body pairs through the selected broad
-// phase, then bodies against the terrain) and the response (gravity, the gyroscopic term, contact impulses, position
-// projection, mowing, and the grass pushed out of every body, with optional grass drag).
+// phase, then bodies against the terrain, with speculative contacts up to each body's reach this
+// tick) and the response (the soft step of sim/collision/contact_solver.h: sub-steps of gravity,
+// the gyroscopic term, warm start, solve, position integration and relax; then restitution and
+// damping; then mowing, and the grass pushed out of every body, with optional grass drag).
 #include "sim/bodies/gyroscopic.h"
 #include "sim/bodies/integrate_bodies.h"
 #include "sim/collision/body_pairs.h"
@@ -12,21 +14,41 @@ namespace sg {
 template <class S>
 void World<S>::detectContacts() {
   contacts_.clear();
+  // How far each body can move this tick, (|v| + |w| r + |g| dt) dt (m): pairs and terrain that
+  // close within it get speculative contacts, so nothing passes through anything in one tick.
+  const S dt = particleConsts_.dt;
+  const S gravityGain = length3(gravityDt_.x(), gravityDt_.y(), gravityDt_.z());
+  std::vector<S> reach(bodies_.size(), S(0)), grown(bodies_.size(), S(0));
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    const RigidBody<S>& b = bodies_[i];  // asleep too: it may be woken below
+    const Vec3<S>& v = b.velocity;
+    const Vec3<S>& w = b.angularVelocity;
+    reach[i] = (length3(v.x(), v.y(), v.z()) + length3(w.x(), w.y(), w.z()) * b.boundingRadius + gravityGain) * dt;
+    grown[i] = reach[i] + speculativeDistance_ / S(2);
+  }
   // Sleeping bodies keep no contacts among themselves or with the terrain; an awake body that
-  // touches a sleeping one wakes it (pairs in (i, j) order: the same wake-ups for any broad phase).
-  for (const auto& [i, j] : bodyPairs(bodies_, bodyBroadphase_)) {
-    RigidBody<S>& a = bodies_[size_t(i)];
-    RigidBody<S>& b = bodies_[size_t(j)];
-    if (a.asleep && b.asleep) continue;
-    const size_t before = contacts_.size();
-    collideBodies(i, a, j, b, contacts_);
-    if (contacts_.size() > before) {
-      if (a.asleep) wake(a);
-      if (b.asleep) wake(b);
+  // touches a sleeping one wakes it and what rests with it (pairs in (i, j) order: the same
+  // wake-ups for any broad phase). A wake-up can make pairs seen earlier in the pass active, so
+  // the pass runs again until nothing more wakes (each rerun wakes at least one island).
+  const auto pairs = bodyPairs(bodies_, bodyBroadphase_, grown);
+  for (bool woke = true; woke;) {
+    woke = false;
+    contacts_.clear();
+    for (const auto& [i, j] : pairs) {
+      RigidBody<S>& a = bodies_[size_t(i)];
+      RigidBody<S>& b = bodies_[size_t(j)];
+      if (a.asleep && b.asleep) continue;
+      const size_t before = contacts_.size();
+      collideBodies(i, a, j, b, contacts_, speculativeDistance_ + reach[size_t(i)] + reach[size_t(j)]);
+      if (contacts_.size() > before && (a.asleep || b.asleep)) {
+        wakeIsland(a.asleep ? i : j);
+        woke = true;
+      }
     }
   }
   for (size_t i = 0; i < bodies_.size(); ++i)
-    if (!bodies_[i].asleep) collideBodyTerrain(int32_t(i), bodies_[i], terrain_, contacts_);
+    if (!bodies_[i].asleep)
+      collideBodyTerrain(int32_t(i), bodies_[i], terrain_, contacts_, speculativeDistance_ + reach[i]);
   sortContacts(contacts_);
 }
 
@@ -53,11 +75,20 @@ bool World<S>::bodiesFaulted(Stage stage) {
 
 template <class S>
 bool World<S>::respondToContacts() {
-  prepareContactRows(bodies_, contacts_, contactRows_);  // before gravity: the approach velocities
-  applyGravity(bodies_, gravityDt_);
-  applyGyroscopicTerm(bodies_, particleConsts_.dt);
-  solveContactVelocities(bodies_, contacts_, contactRows_, solver_, impulseCache_);
-  solveContactPositions(bodies_, contacts_, contactRows_, particleConsts_.dt, solver_);
+  prepareContacts(bodies_, contacts_, impulseCache_, contactRows_);  // before gravity: the approach velocities
+  for (int sub = 0; sub < solver_.substeps; ++sub) {
+    applyGravity(bodies_, gravitySubstep_);
+    applyGyroscopicTerm(bodies_, substepDt_);
+    warmStartContacts(bodies_, contactRows_);
+    for (int it = 0; it < solver_.solveIterations; ++it) solveContacts(bodies_, contactRows_, solver_, true);
+    integrateBodyPositions(bodies_, substepDt_);
+    for (int it = 0; it < solver_.relaxIterations; ++it) solveContacts(bodies_, contactRows_, solver_, false);
+  }
+  // Stored before restitution: the next tick warm-starts with the sub-step's resting impulse, not
+  // with the one-off bounce (re-applied, it held a bounced ball on the ground for a tick).
+  storeImpulses(bodies_, contacts_, contactRows_, solver_, impulseCache_);
+  applyRestitution(bodies_, contactRows_, solver_);
+  applyDamping(bodies_);
   if (bodiesFaulted(Stage::Response)) return false;
   mowGrass();
   // Grass: pushed out of every body (particle rows in parallel, bodies in id order).

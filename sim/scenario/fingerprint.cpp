@@ -51,7 +51,8 @@ uint64_t scenarioFingerprint(const Scenario& s) {
   if (!s.bodies.list.empty()) {
     const auto& b = s.bodies;
     // Not the broad phases: they are promised to give the same state, so they must not change it.
-    putInts(h, {b.velocityIterations, b.positionIterations, int64_t(b.boxParticleNormal), int64_t(b.list.size())});
+    putInts(h, {b.substeps, b.velocityIterations, b.positionIterations, int64_t(b.boxParticleNormal),
+                int64_t(b.list.size())});
     for (const Rational& g : b.gravity) putRational(h, g);
     putRational(h, b.grassDrag);
     putRational(h, b.mowerCutHeight);

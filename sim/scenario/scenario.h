@@ -158,8 +158,11 @@ struct Scenario {
 
   struct Bodies {
     Rational3 gravity{Rational{0, 1}, Rational{-981, 100}, Rational{0, 1}};  ///< m/s^2
-    int velocityIterations = 16;  // 8 lets a 5-box stack walk and fall (tests/body_accuracy_test.cpp)
-    int positionIterations = 8;   ///< per contact (Cyclone: twice the contact count)
+    /// The soft step (sim/collision/contact_solver.h): sub-steps per tick, and solve and relax
+    /// sweeps per sub-step (Box2D v3's defaults: 4, 1, 1).
+    int substeps = 4;
+    int velocityIterations = 3;  ///< solve sweeps per sub-step
+    int positionIterations = 1;  ///< relax sweeps per sub-step (0: the push velocity stays)
     ParticleBroadphase particleBroadphase = ParticleBroadphase::Grid;
     BodyBroadphase bodyBroadphase = BodyBroadphase::Brute;
     BoxParticleNormal boxParticleNormal = BoxParticleNormal::Up;

@@ -448,11 +448,12 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
 void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
   const std::string p = "$.bodies";
   r.object(j, p,
-           {"gravity", "velocityIterations", "positionIterations", "particleBroadphase", "bodyBroadphase",
+           {"gravity", "substeps", "velocityIterations", "positionIterations", "particleBroadphase", "bodyBroadphase",
             "boxParticleNormal", "mowerCutHeight", "grassDrag", "list"});
   if (j.contains("grassDrag")) b.grassDrag = r.nonNegative(j["grassDrag"], p + ".grassDrag");
   if (j.contains("mowerCutHeight")) b.mowerCutHeight = r.nonNegative(j["mowerCutHeight"], p + ".mowerCutHeight");
   if (j.contains("gravity")) b.gravity = r.vector<3>(j["gravity"], p + ".gravity");
+  if (j.contains("substeps")) b.substeps = int(r.integer(j["substeps"], p + ".substeps", 1, 64));
   if (j.contains("velocityIterations"))
     b.velocityIterations = int(r.integer(j["velocityIterations"], p + ".velocityIterations", 1, 1000));
   if (j.contains("positionIterations"))

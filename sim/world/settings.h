@@ -13,12 +13,29 @@ struct Exact {
 };
 
 // ---- contact solver (sim/collision/contact_solver.cpp) -------------------------------------
-/// Approaches slower than this (m/s) do not bounce (Box2D's b2_velocityThreshold): below it,
-/// restitution plus the energy the position projection adds keeps a ball hopping forever.
+/// Approaches slower than this (m/s) do not bounce (Box2D's b2_velocityThreshold): a resting
+/// body's contacts approach at g h every sub-step and must not hop.
 inline constexpr Exact kRestitutionThreshold{1, 1};
-/// Penetration the position projection leaves alone (m): resting contacts stay in contact, so
-/// they neither jitter nor lose their warm-start impulses (Box2D's b2_linearSlop is 5 mm).
-inline constexpr Exact kLinearSlop{1, 2000};
+/// Soft contacts (Box2D v3's contactHertz 30, contactDampingRatio 10, contactSpeed 3 m/s): the
+/// spring that pushes overlap out, capped below a quarter of the sub-step rate (stiffer is not
+/// resolved by the sub-step), heavily overdamped so it does not bounce, and never faster than
+/// kContactPushMaxVelocity. Terrain contacts use twice the frequency (nothing there gives way).
+inline constexpr Exact kContactHertz{60, 1};
+inline constexpr Exact kContactDampingRatio{10, 1};
+inline constexpr Exact kContactPushMaxVelocity{3, 1};
+/// Shapes this close (m) get speculative contacts even when nothing moves (Box2D's
+/// b2_speculativeDistance, 4 x its 5 mm slop): a resting contact that opens by rounding or a
+/// small hop keeps its row and its warm-start impulses. The world adds each body's motion in
+/// the tick, (|v| + |g| dt) dt, for continuous collision.
+inline constexpr Exact kSpeculativeDistance{1, 50};
+/// Overlap a resting contact may keep (m, Box2D's b2_linearSlop): a body with a contact deeper
+/// than this is still being pushed out (at up to kContactPushMaxVelocity, a motion the relax pass
+/// hides from its velocity), so it may not fall asleep: a sphere started 1.5 m under the ground
+/// fell asleep 8 cm inside it.
+inline constexpr Exact kLinearSlop{1, 200};
+/// pi for the soft constraints' 2 pi hertz (355/113: 3e-7 relative, far below what a stiffness
+/// needs; an exact fraction, so every scalar rounds it once).
+inline constexpr Exact kPi{355, 113};
 
 // ---- sleep (sim/bodies/integrate_bodies.h) --------------------------------------------------
 /// A body below both speeds for kSleepTime falls asleep (m/s, rad/s, s).

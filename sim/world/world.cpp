@@ -121,12 +121,29 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
     bodies_.push_back(
         makeBody<S>(s.bodies.list[i], s.timeStep, s.sourceName, "$.bodies.list[" + std::to_string(i) + "]"));
   initialBodies_ = bodies_;
-  gravityDt_ = Vec3<S>(toS<S>(s.bodies.gravity[0]), toS<S>(s.bodies.gravity[1]), toS<S>(s.bodies.gravity[2])) *
-               particleConsts_.dt;
-  solver_.velocityIterations = s.bodies.velocityIterations;
-  solver_.positionIterationsPerContact = s.bodies.positionIterations;
+  // The soft step's sub-step h = dt / substeps and its rate, each rounded once from exact values.
+  solver_.substeps = s.bodies.substeps;
+  solver_.solveIterations = s.bodies.velocityIterations;
+  solver_.relaxIterations = s.bodies.positionIterations;
+  const Rational substep = *div(s.timeStep, Rational{s.bodies.substeps, 1});
+  substepDt_ = toS<S>(substep);
+  solver_.invSubstep = toS<S>(*div(Rational{s.bodies.substeps, 1}, s.timeStep));
+  const Vec3<S> gravity(toS<S>(s.bodies.gravity[0]), toS<S>(s.bodies.gravity[1]), toS<S>(s.bodies.gravity[2]));
+  gravityDt_ = gravity * particleConsts_.dt;
+  solver_.gravity = gravity;
+  gravitySubstep_ = gravity * substepDt_;
   solver_.restitutionThreshold = toS<S>(exact(settings::kRestitutionThreshold));
+  solver_.maxPushVelocity = toS<S>(exact(settings::kContactPushMaxVelocity));
   solver_.linearSlop = toS<S>(exact(settings::kLinearSlop));
+  {
+    // Box2D: contact hertz at most a quarter of the sub-step rate; the terrain twice as stiff.
+    const S quarterRate = solver_.invSubstep / S(4);
+    const S hertz = minS(toS<S>(exact(settings::kContactHertz)), quarterRate);
+    const S zeta = toS<S>(exact(settings::kContactDampingRatio)), pi = toS<S>(exact(settings::kPi));
+    solver_.bodySoftness = makeSoftness(hertz, zeta, substepDt_, pi);
+    solver_.staticSoftness = makeSoftness(S(2) * hertz, zeta, substepDt_, pi);
+  }
+  speculativeDistance_ = toS<S>(exact(settings::kSpeculativeDistance));
   bodyBroadphase_ = s.bodies.bodyBroadphase;
   grassDragDt_ = toS<S>(s.bodies.grassDrag) * particleConsts_.dt;
   sleepLinear_ = toS<S>(exact(settings::kSleepLinearSpeed));

@@ -98,6 +98,8 @@ class World final : public SimWorld {
   void resetBody(size_t body);
   void wakeBodiesNear(const Vec3<S>& centre,
                       S radius);  ///< every sleeping body whose bounds come within 5 cm (per axis)
+  /// Wakes `body` and every sleeping body near it, transitively (sim/bodies/sleep_islands.h).
+  void wakeIsland(int32_t body);
   void spawnBody(int32_t templateBody, const InputVec3& at);
   void dropCachedImpulses(size_t body);
   void detectContacts();
@@ -152,7 +154,10 @@ class World final : public SimWorld {
   std::vector<ContactRow<S>> contactRows_;  ///< scratch of the response stage (not state)
   BodyParticleSettings<S> bodyParticle_;
   BodyBroadphase bodyBroadphase_ = BodyBroadphase::Brute;
-  Vec3<S> gravityDt_ = Vec3<S>::Zero();
+  Vec3<S> gravityDt_ = Vec3<S>::Zero();       ///< g dt (m/s): a body's speed gain in one tick
+  Vec3<S> gravitySubstep_ = Vec3<S>::Zero();  ///< g h (m/s) for one sub-step
+  S substepDt_{};                             ///< h = dt / substeps (s)
+  S speculativeDistance_{};                   ///< m (settings::kSpeculativeDistance)
   S sleepLinear_{}, sleepAngular_{};
   S grassDragDt_{};  ///< grassDrag * dt (N s/m * s = kg per tuft)
   int32_t ticksToSleep_ = 30;

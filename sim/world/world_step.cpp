@@ -1,7 +1,7 @@
 // The step of World<S>: one fixed tick as a sequence of stages in the thesis order (runPhysics,
 // thesis section 9.2). Each stage is timed through the observer (begin and end always paired) and
 // a fault is attributed to the stage that raised it.
-#include "sim/bodies/integrate_bodies.h"
+#include "sim/bodies/sleep_islands.h"
 #include "sim/world/settings.h"
 #include "sim/world/world.h"
 #include "sim/world/world_rows.h"
@@ -130,8 +130,9 @@ bool World<S>::integrateStage() {
                : advanceParticleRow<S, false>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_);
   });
   if (!moved || bodies_.empty()) return moved;
-  integrateBodyPositions(bodies_, c.dt);
-  updateSleep(bodies_, sleepLinear_, sleepAngular_, ticksToSleep_);
+  // The bodies moved in the response stage (the soft step integrates their positions in every
+  // sub-step); here they may fall asleep, by islands.
+  updateSleep(bodies_, contacts_, sleepLinear_, sleepAngular_, ticksToSleep_);
   return !bodiesFaulted(Stage::Integrate);
 }
 
