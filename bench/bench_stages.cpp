@@ -153,11 +153,11 @@ void BM_BroadPhase(benchmark::State& state) {
   const sg::ParticleGrid& grid = world.particleGrid();
   int64_t candidates = 0;
   for (auto _ : state) {
-    const std::vector<sg::ParticleRange> ranges = sg::particleRanges(world.bodies(), grid, settings);
-    benchmark::DoNotOptimize(
-        sg::pushParticlesOutOfBodies(particles, grid, world.bodies(), ranges, settings, 0, grid.countZ, nullptr));
+    const sg::GrassPushers<S> pushers = sg::prepareGrassPushers(world.bodies(), grid, settings);
+    benchmark::DoNotOptimize(sg::pushParticlesOutOfBodies(particles, grid, pushers, settings, 0, grid.countZ, nullptr));
     candidates = 0;
-    for (const sg::ParticleRange& r : ranges) candidates += (r.a1 - r.a0 + 1) * (r.b1 - r.b0 + 1);
+    for (const sg::GrassPusher<S>& p : pushers.parts)
+      candidates += (p.range.a1 - p.range.a0 + 1) * (p.range.b1 - p.range.b0 + 1);
   }
   state.counters["particles"] = double(grid.size());
   state.counters["candidate_cells"] = double(candidates);

@@ -42,11 +42,40 @@ template <class S>
 std::vector<ParticleRange> particleRanges(const std::vector<RigidBody<S>>& bodies, const ParticleGrid& grid,
                                           const BodyParticleSettings<S>& settings);
 
-/// Applies every body to particle rows [rowBegin, rowEnd). Adds the number of particles each body
-/// pushed to pushedPerBody[body] (may be null). Returns the first faulting particle or -1.
+/// One body part as the grass sees it this tick: its pose, shape, how much of the overlap the
+/// particle takes (share), and the lattice range of its candidates.
 template <class S>
-int64_t pushParticlesOutOfBodies(ParticleArrays<S>& particles, const ParticleGrid& grid,
-                                 const std::vector<RigidBody<S>>& bodies, const std::vector<ParticleRange>& ranges,
+struct GrassPusher {
+  Pose<S> pose;
+  const BodyPart<S>* shape = nullptr;
+  S share{};
+  ParticleRange range;
+  int32_t body = 0;
+};
+
+/// The pushers of one tick, bucketed by lattice row (compressed rows): the pushers that may touch
+/// lattice row b are byRow[rowStart[b - originJ] .. rowStart[b - originJ + 1]), in (body, part)
+/// order. A row then visits only the parts over it: the stage costs O(rows + parts x rows they
+/// span + candidate particles), not O(rows x bodies) (with 300 bodies the per-row scan of every
+/// body was 76 % of a thesis-meadow tick).
+template <class S>
+struct GrassPushers {
+  std::vector<GrassPusher<S>> parts;
+  std::vector<int64_t> rowStart;  ///< window rows + 1 offsets into byRow
+  std::vector<int32_t> byRow;
+  int64_t originJ = 0;
+};
+
+/// Builds this tick's pushers from the bodies (poses and shares computed once, not per row).
+template <class S>
+GrassPushers<S> prepareGrassPushers(const std::vector<RigidBody<S>>& bodies, const ParticleGrid& grid,
+                                    const BodyParticleSettings<S>& settings);
+
+/// Applies every pusher to particle rows [rowBegin, rowEnd) (storage rows). Adds the number of
+/// particles each body pushed to pushedPerBody[body] (may be null). Returns the first faulting
+/// particle or -1.
+template <class S>
+int64_t pushParticlesOutOfBodies(ParticleArrays<S>& particles, const ParticleGrid& grid, const GrassPushers<S>& pushers,
                                  const BodyParticleSettings<S>& settings, int64_t rowBegin, int64_t rowEnd,
                                  int64_t* pushedPerBody);
 

@@ -15,40 +15,46 @@ Vec3<S> tangentOf(const Vec3<S>& n) {
   return t / length3(t.x(), t.y(), t.z());
 }
 
+/// The axis `dir` of a contact at arms rA (and rB unless B is the terrain).
 template <class S>
-S inverseMassAlong(const RigidBody<S>& body, const Vec3<S>& r, const Vec3<S>& dir) {
-  const Vec3<S> rxd = r.cross(dir);
-  return body.invMass + (body.invInertiaWorld * rxd).cross(r).dot(dir);
+ContactAxis<S> makeAxis(const Vec3<S>& dir, const RigidBody<S>& A, const Vec3<S>& rA, const RigidBody<S>* B,
+                        const Vec3<S>& rB) {
+  ContactAxis<S> x;
+  x.dir = dir;
+  x.armA = rA.cross(dir);
+  x.turnA = A.invInertiaWorld * x.armA;
+  S k = A.invMass + x.armA.dot(x.turnA);
+  if (B) {
+    x.armB = rB.cross(dir);
+    x.turnB = B->invInertiaWorld * x.armB;
+    k += B->invMass + x.armB.dot(x.turnB);
+  }
+  x.mass = k > S(0) ? S(1) / k : S(0);
+  return x;
 }
 
+/// Relative velocity of A against B along the axis (m/s).
 template <class S>
-Vec3<S> velocityAt(const RigidBody<S>& body, const Vec3<S>& r) {
-  return body.velocity + body.angularVelocity.cross(r);
-}
-
-template <class S>
-void applyImpulse(RigidBody<S>& body, const Vec3<S>& r, const Vec3<S>& impulse) {
-  body.velocity += impulse * body.invMass;
-  body.angularVelocity += body.invInertiaWorld * r.cross(impulse);
-}
-
-template <class S>
-Vec3<S> relativeVelocity(const std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row) {
-  Vec3<S> v = velocityAt(bodies[size_t(row.a)], row.rA);
-  if (row.b != kTerrainBody) v -= velocityAt(bodies[size_t(row.b)], row.rB);
+S axisVelocity(const std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row, const ContactAxis<S>& x) {
+  const RigidBody<S>& A = bodies[size_t(row.a)];
+  S v = A.velocity.dot(x.dir) + A.angularVelocity.dot(x.armA);
+  if (row.b != kTerrainBody) {
+    const RigidBody<S>& B = bodies[size_t(row.b)];
+    v -= B.velocity.dot(x.dir) + B.angularVelocity.dot(x.armB);
+  }
   return v;
 }
 
+/// Applies an impulse p (N s) along the axis: +p to A, -p to B.
 template <class S>
-void applyPair(std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row, const Vec3<S>& impulse) {
-  applyImpulse(bodies[size_t(row.a)], row.rA, impulse);
-  if (row.b != kTerrainBody) applyImpulse(bodies[size_t(row.b)], row.rB, Vec3<S>(-impulse));
-}
-
-/// 1 / k, or 0 when k is not positive (an immovable direction).
-template <class S>
-S invertPositive(S k) {
-  return k > S(0) ? S(1) / k : S(0);
+void applyAxisImpulse(std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row, const ContactAxis<S>& x, S p) {
+  RigidBody<S>& A = bodies[size_t(row.a)];
+  A.velocity += x.dir * (p * row.invMassA);
+  A.angularVelocity += x.turnA * p;
+  if (row.b == kTerrainBody) return;
+  RigidBody<S>& B = bodies[size_t(row.b)];
+  B.velocity -= x.dir * (p * row.invMassB);
+  B.angularVelocity -= x.turnB * p;
 }
 
 }  // namespace
@@ -126,9 +132,9 @@ void matchCachedImpulses(const std::vector<Contact<S>>& contacts, const std::vec
   for (size_t i = 0; i < rows.size(); ++i) {
     if (match[i] == cache.size()) continue;
     const CachedImpulse<S>& hit = cache[match[i]];
-    rows[i].impulseN = hit.normal;
-    rows[i].impulseT1 = hit.tangent1;
-    rows[i].impulseT2 = hit.tangent2;
+    rows[i].normal.impulse = hit.normal;
+    rows[i].t1.impulse = hit.tangent1;
+    rows[i].t2.impulse = hit.tangent2;
   }
 }
 
@@ -137,7 +143,7 @@ void matchCachedImpulses(const std::vector<Contact<S>>& contacts, const std::vec
 template <class S>
 Vec3<S> anchorDifference(const std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row) {
   const RigidBody<S>& A = bodies[size_t(row.a)];
-  const Vec3<S> d = A.position + A.rotation * row.localA;
+  Vec3<S> d = A.position + A.rotation * row.localA;
   if (row.b == kTerrainBody) return d;
   const RigidBody<S>& B = bodies[size_t(row.b)];
   return d - (B.position + B.rotation * row.localB);
@@ -156,31 +162,25 @@ void prepareContacts(const std::vector<RigidBody<S>>& bodies, const std::vector<
     row.a = c.bodyA;
     row.b = c.bodyB;
     const RigidBody<S>& A = bodies[size_t(c.bodyA)];
-    row.rA = c.point - A.position;
-    row.localA = A.rotation.transpose() * row.rA;
-    row.normal = c.normal;
-    row.t1 = tangentOf(c.normal);
-    row.t2 = c.normal.cross(row.t1);
+    const RigidBody<S>* B = c.bodyB == kTerrainBody ? nullptr : &bodies[size_t(c.bodyB)];
+    const Vec3<S> rA = c.point - A.position;
+    const Vec3<S> rB = B ? Vec3<S>(c.point - B->position) : Vec3<S>(Vec3<S>::Zero());
+    row.localA = A.rotation.transpose() * rA;
+    if (B) row.localB = B->rotation.transpose() * rB;
+    const Vec3<S> t1 = tangentOf(c.normal);
+    row.normal = makeAxis(c.normal, A, rA, B, rB);
+    row.t1 = makeAxis(t1, A, rA, B, rB);
+    row.t2 = makeAxis(Vec3<S>(c.normal.cross(t1)), A, rA, B, rB);
     row.separation = -c.penetration;
-    S kN = inverseMassAlong(A, row.rA, row.normal);
-    S kT1 = inverseMassAlong(A, row.rA, row.t1);
-    S kT2 = inverseMassAlong(A, row.rA, row.t2);
+    row.invMassA = A.invMass;
     row.restitution = A.restitution;
     row.friction = A.friction;
-    if (c.bodyB != kTerrainBody) {
-      const RigidBody<S>& B = bodies[size_t(c.bodyB)];
-      row.rB = c.point - B.position;
-      row.localB = B.rotation.transpose() * row.rB;
-      kN += inverseMassAlong(B, row.rB, row.normal);
-      kT1 += inverseMassAlong(B, row.rB, row.t1);
-      kT2 += inverseMassAlong(B, row.rB, row.t2);
-      row.restitution = A.restitution < B.restitution ? B.restitution : A.restitution;
-      row.friction = sqrt(A.friction * B.friction);
+    if (B) {
+      row.invMassB = B->invMass;
+      row.restitution = A.restitution < B->restitution ? B->restitution : A.restitution;
+      row.friction = sqrt(A.friction * B->friction);
     }
     row.anchorGap = anchorDifference(bodies, row);  // the separation's reference: s is exact at prepare
-    row.massN = invertPositive(kN);
-    row.massT1 = invertPositive(kT1);
-    row.massT2 = invertPositive(kT2);
   }
   matchCachedImpulses(contacts, cache, rows);
 }
@@ -188,15 +188,16 @@ void prepareContacts(const std::vector<RigidBody<S>>& bodies, const std::vector<
 template <class S>
 void warmStartContacts(std::vector<RigidBody<S>>& bodies, const std::vector<ContactRow<S>>& rows) {
   for (const ContactRow<S>& row : rows)
-    applyPair(bodies, row, Vec3<S>(row.normal * row.impulseN + row.t1 * row.impulseT1 + row.t2 * row.impulseT2));
+    for (const ContactAxis<S>* x : {&row.normal, &row.t1, &row.t2}) applyAxisImpulse(bodies, row, *x, x->impulse);
 }
 
 template <class S>
 void solveContacts(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows,
                    const SolverSettings<S>& settings, bool useBias) {
   for (ContactRow<S>& row : rows) {
+    ContactAxis<S>& n = row.normal;
     // The separation now: the anchors moved with their bodies since prepare.
-    const S s = row.separation + (anchorDifference(bodies, row) - row.anchorGap).dot(row.normal);
+    const S s = row.separation + (anchorDifference(bodies, row) - row.anchorGap).dot(n.dir);
     S bias(0), massScale(1), impulseScale(0);
     if (s > S(0)) {
       // Speculative: close at most the gap in this sub-step. Only in the solve, which the
@@ -212,11 +213,11 @@ void solveContacts(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>
       impulseScale = soft.impulseScale;
     }
     // Normal: push apart until the bodies stop closing (faster than the bias allows); never pull.
-    const S vn = relativeVelocity(bodies, row).dot(row.normal);
-    S lambda = -row.massN * massScale * (vn + bias) - impulseScale * row.impulseN;
-    const S total = maxS(row.impulseN + lambda, S(0));
-    lambda = total - row.impulseN;
-    row.impulseN = total;
+    const S vn = axisVelocity(bodies, row, n);
+    const S lambda = -n.mass * massScale * (vn + bias) - impulseScale * n.impulse;
+    const S total = maxS(n.impulse + lambda, S(0));
+    applyAxisImpulse(bodies, row, n, S(total - n.impulse));
+    n.impulse = total;
     // The fastest approach any push met. Not just the first: a ball that left the ground at V
     // comes back down through the same discrete positions (the integrator is time-reversible)
     // and lands exactly on the surface, where rounding makes a push of ~1e-16 one sub-step
@@ -226,19 +227,13 @@ void solveContacts(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>
       row.impactGap = maxS(s, S(0));
     }
     row.maxImpulseN = maxS(row.maxImpulseN, total);
-
-    applyPair(bodies, row, Vec3<S>(row.normal * lambda));
     // Friction: stop the sliding velocity, within the Coulomb cone mu * normal impulse.
-    const S limit = row.friction * row.impulseN;
-    for (int t = 0; t < 2; ++t) {
-      const Vec3<S>& dir = t == 0 ? row.t1 : row.t2;
-      S& accumulated = t == 0 ? row.impulseT1 : row.impulseT2;
-      const S vt = relativeVelocity(bodies, row).dot(dir);
-      const S wanted = accumulated - vt * (t == 0 ? row.massT1 : row.massT2);
+    const S limit = row.friction * n.impulse;
+    for (ContactAxis<S>* t : {&row.t1, &row.t2}) {
+      const S wanted = t->impulse - axisVelocity(bodies, row, *t) * t->mass;
       const S clamped = wanted < -limit ? -limit : (wanted > limit ? limit : wanted);
-      const S delta = clamped - accumulated;
-      accumulated = clamped;
-      applyPair(bodies, row, Vec3<S>(dir * delta));
+      applyAxisImpulse(bodies, row, *t, S(clamped - t->impulse));
+      t->impulse = clamped;
     }
   }
 }
@@ -251,6 +246,7 @@ void applyRestitution(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<
   for (ContactRow<S>& row : rows) {
     if (!(row.maxImpulseN > S(0)) || !(row.impactVelocity < -settings.restitutionThreshold)) continue;
     if (row.restitution == S(0)) continue;
+    ContactAxis<S>& n = row.normal;
     // A speculative push stopped the body `impactGap` short of where it would have met the
     // surface (it then rests on it for the rest of the tick): against the terrain, gravity
     // would have sped it up over that gap, so the impact speed gets the gain of
@@ -260,15 +256,14 @@ void applyRestitution(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<
     // in a minute). Between two bodies gravity pulls both alike: no relative gain.
     S impactSpeed = -row.impactVelocity;
     if (row.b == kTerrainBody && row.impactGap > S(0)) {
-      const S pull = -settings.gravity.dot(row.normal);  // m/s^2 towards the surface
+      const S pull = -settings.gravity.dot(n.dir);  // m/s^2 towards the surface
       if (pull > S(0)) impactSpeed += pull * row.impactGap / impactSpeed;
     }
-    const S vn = relativeVelocity(bodies, row).dot(row.normal);
-    S lambda = -(vn - row.restitution * impactSpeed) * row.massN;
-    const S total = maxS(row.impulseN + lambda, S(0));
-    lambda = total - row.impulseN;
-    row.impulseN = total;
-    applyPair(bodies, row, Vec3<S>(row.normal * lambda));
+    const S vn = axisVelocity(bodies, row, n);
+    const S lambda = -(vn - row.restitution * impactSpeed) * n.mass;
+    const S total = maxS(n.impulse + lambda, S(0));
+    applyAxisImpulse(bodies, row, n, S(total - n.impulse));
+    n.impulse = total;
   }
 }
 
@@ -289,8 +284,8 @@ void storeImpulses(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<
       deep[size_t(row.a)] = 1;
       if (row.b != kTerrainBody) deep[size_t(row.b)] = 1;
     }
-    const S used = maxS(abs(row.impulseT1), abs(row.impulseT2));
-    const S most = row.friction * row.impulseN;
+    const S used = maxS(abs(row.t1.impulse), abs(row.t2.impulse));
+    const S most = row.friction * row.normal.impulse;
     for (const int32_t id : {row.a, row.b}) {
       if (id == kTerrainBody) continue;
       friction[size_t(id)] += used;
@@ -304,7 +299,8 @@ void storeImpulses(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<
   cache.clear();
   for (size_t i = 0; i < rows.size(); ++i)
     cache.push_back(CachedImpulse<S>{contacts[i].bodyA, contacts[i].bodyB, contacts[i].featureA, contacts[i].featureB,
-                                     rows[i].impulseN, rows[i].impulseT1, rows[i].impulseT2, contacts[i].point});
+                                     rows[i].normal.impulse, rows[i].t1.impulse, rows[i].t2.impulse,
+                                     contacts[i].point});
 }
 
 #define SG_INSTANTIATE(S)                                                                                            \

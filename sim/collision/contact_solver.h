@@ -89,20 +89,31 @@ struct CachedImpulse {
   friend bool operator==(const CachedImpulse&, const CachedImpulse&) = default;
 };
 
-/// One contact as the solver sees it (one normal and two friction rows).
+/// One direction of a contact row (the normal or a friction tangent) with its Jacobian
+/// precomputed at prepare, so a sweep is dot products and axpys, no cross product or matrix
+/// (Box2D keeps rn = r x n the same way): the relative velocity along `dir` is
+/// vA.dir + wA.armA - vB.dir - wB.armB, and an impulse p along it changes wA by turnA p.
+template <class S>
+struct ContactAxis {
+  Vec3<S> dir = Vec3<S>::Zero();                             ///< unit
+  Vec3<S> armA = Vec3<S>::Zero(), armB = Vec3<S>::Zero();    ///< m: rA x dir, rB x dir
+  Vec3<S> turnA = Vec3<S>::Zero(), turnB = Vec3<S>::Zero();  ///< 1/(kg m): I^-1 (r x dir) of each body
+  S mass{};     ///< kg: 1 / (1/mA + 1/mB + armA.turnA + armB.turnB); 0 when immovable
+  S impulse{};  ///< N s per sub-step, accumulated
+};
+
+/// One contact as the solver sees it: the normal and two friction axes.
 template <class S>
 struct ContactRow {
-  Vec3<S> rA, rB;          ///< m: contact point relative to the centres of mass at the tick's start (velocity arms)
-  Vec3<S> localA, localB;  ///< m: the same arms in each body's frame (they turn with the body)
+  ContactAxis<S> normal, t1, t2;
+  Vec3<S> localA, localB;  ///< m: contact point from each centre of mass in the body's frame (turns with it)
   Vec3<S> anchorGap;       ///< m: A's anchor - B's anchor (terrain: A's alone) at prepare; s starts exact
-  Vec3<S> normal, t1, t2;
-  S separation{};                 ///< m at prepare: minus the penetration (> 0: speculative)
-  S massN{}, massT1{}, massT2{};  ///< kg: 1 / effective inverse mass along each direction
-  S impactVelocity{};             ///< m/s: the most negative normal velocity a pushing solve met this tick
-  S impactGap{};                  ///< m: the separation (>= 0) when it did (a speculative stop short of the surface)
+  S separation{};          ///< m at prepare: minus the penetration (> 0: speculative)
+  S invMassA{}, invMassB{};
+  S impactVelocity{};  ///< m/s: the most negative normal velocity a pushing solve met this tick
+  S impactGap{};       ///< m: the separation (>= 0) when it did (a speculative stop short of the surface)
   S restitution{}, friction{};
-  S impulseN{}, impulseT1{}, impulseT2{};  ///< N s per sub-step, accumulated
-  S maxImpulseN{};                         ///< the largest normal impulse of any sub-step (did it push?)
+  S maxImpulseN{};  ///< the largest normal impulse of any sub-step (did it push?)
   int32_t a = 0, b = kTerrainBody;
 };
 

@@ -92,12 +92,12 @@ bool World<S>::respondToContacts() {
   if (bodiesFaulted(Stage::Response)) return false;
   mowGrass();
   // Grass: pushed out of every body (particle rows in parallel, bodies in id order).
-  const std::vector<ParticleRange> ranges = particleRanges(bodies_, grid_, bodyParticle_);
+  const GrassPushers<S> pushers = prepareGrassPushers(bodies_, grid_, bodyParticle_);
   const bool drag = grassDragDt_ > S(0);
   // Per-row push counts (integers, summed in row order below: the same for any thread count).
   std::vector<int64_t> pushed(drag ? size_t(grid_.countZ) * bodies_.size() : 0, 0);
   const bool ok = runParticleRows(Stage::Response, [&](int64_t row, int64_t, int64_t) {
-    return pushParticlesOutOfBodies(particles_, grid_, bodies_, ranges, bodyParticle_, row, row + 1,
+    return pushParticlesOutOfBodies(particles_, grid_, pushers, bodyParticle_, row, row + 1,
                                     drag ? pushed.data() + size_t(row) * bodies_.size() : nullptr);
   });
   if (!ok || !drag) return ok;
