@@ -49,6 +49,18 @@ BodySpec box(const std::string& name, Rational3 half, Rational3 position, Ration
   return b;
 }
 
+/// "prefix<i>" or "prefix<i>_<j>" (appended, not operator+ on a temporary: GCC 12's -Wrestrict
+/// misfires on that at -O3).
+std::string named(const char* prefix, int i, int j = -1) {
+  std::string name = prefix;
+  name += std::to_string(i);
+  if (j >= 0) {
+    name += '_';
+    name += std::to_string(j);
+  }
+  return name;
+}
+
 Rational3 half(int64_t mmX, int64_t mmY, int64_t mmZ) { return {mm(mmX), mm(mmY), mm(mmZ)}; }
 Rational3 at(int64_t mmX, int64_t mmY, int64_t mmZ) { return {mm(mmX), mm(mmY), mm(mmZ)}; }
 
@@ -86,8 +98,7 @@ Scenario stackOf(int count) {
   Scenario s = emptyWorld();
   // 0.5 m cubes of 1 kg, 1 mm apart (and 1 mm above the ground): they settle onto each other.
   for (int i = 0; i < count; ++i)
-    s.bodies.list.push_back(
-        box("box" + std::to_string(i), half(250, 250, 250), at(0, 251 + 501 * i, 0), Rational{1, 1}));
+    s.bodies.list.push_back(box(named("box", i), half(250, 250, 250), at(0, 251 + 501 * i, 0), Rational{1, 1}));
   return s;
 }
 
@@ -115,8 +126,7 @@ Scenario pyramid(int base) {
   for (int row = 0; row < base; ++row)
     for (int k = 0; k < base - row; ++k) {
       const int64_t x = (2 * k - (base - row - 1)) * 255;  // mm: centres 510 mm apart
-      s.bodies.list.push_back(box("b" + std::to_string(row) + "_" + std::to_string(k), half(250, 250, 250),
-                                  at(x, 251 + 501 * row, 0), Rational{1, 1}));
+      s.bodies.list.push_back(box(named("b", row, k), half(250, 250, 250), at(x, 251 + 501 * row, 0), Rational{1, 1}));
     }
   return s;
 }
@@ -240,9 +250,9 @@ void expectEnergyNeverRises(const char* name) {
     // restitution e = tenths / 10 <= 1 and friction 0.5: nothing outside adds energy.
     Scenario s = emptyWorld();
     for (int i = 0; i < 12; ++i) {
-      BodySpec b = i % 3 == 0 ? box("b" + std::to_string(i), half(200, 150, 250), {}, Rational{1 + i, 1})
+      BodySpec b = i % 3 == 0 ? box(named("b", i), half(200, 150, 250), {}, Rational{1 + i, 1})
                               : test::sphere("s", mm(150 + 20 * i), {});
-      b.name = "b" + std::to_string(i);
+      b.name = named("b", i);
       b.position = at(300 * (i % 4) - 450, 1000 + 700 * i, 300 * (i / 4) - 300);
       b.mass = Rational{1 + i, 1};
       b.restitution = *Rational::make(tenths, 10);
@@ -271,6 +281,52 @@ void expectEnergyNeverRises(const char* name) {
 TEST(SoftStep, EnergyNeverRisesInAClosedSystemFx32) { expectEnergyNeverRises<Fx32>("fx32"); }
 TEST(SoftStep, EnergyNeverRisesInAClosedSystemFx16) { expectEnergyNeverRises<Fx16>("fx16"); }
 TEST(SoftStep, EnergyNeverRisesInAClosedSystemDouble) { expectEnergyNeverRises<double>("double"); }
+
+// ---- fx16's rigid-body envelope (docs/fixed-point.md) ---------------------------------------------
+std::string loadError(Scenario s, ScalarKind scalar) {
+  try {
+    validateForScalar(s, scalar, 0);
+  } catch (const ScenarioError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(SoftStep, Fx16EnvelopeIsCheckedAtLoadAndHoldsInside) {
+  // Outside: a tennis ball (57 g, 3.3 cm: inertia 2.5e-5 kg m^2, its inverse beyond 32,767) and a
+  // 100 kg ball at 400 m/s (40,000 N s, beyond the largest impulse) are refused at load, naming
+  // the key and the bound; fx32 takes both.
+  Scenario tennis = emptyWorld();
+  tennis.bodies.list = {test::sphere("tennis", mm(33), at(0, 1000, 0))};
+  tennis.bodies.list[0].mass = mm(57);
+  const std::string e1 = loadError(tennis, ScalarKind::Fx16);
+  EXPECT_NE(e1.find("$.bodies.list[0].mass"), std::string::npos) << e1;
+  EXPECT_NE(e1.find("1/inertia"), std::string::npos) << e1;
+  EXPECT_NE(e1.find("use fx32"), std::string::npos) << e1;
+  EXPECT_EQ(loadError(tennis, ScalarKind::Fx32), "");
+  Scenario fast = emptyWorld();
+  fast.bodies.list = {test::sphere("fast", mm(100), at(0, 2000, 0))};
+  fast.bodies.list[0].mass = Rational{100, 1};
+  fast.bodies.list[0].velocity = {Rational{0, 1}, Rational{-400, 1}, Rational{0, 1}};
+  const std::string e2 = loadError(fast, ScalarKind::Fx16);
+  EXPECT_NE(e2.find("$.bodies.list[0].velocity"), std::string::npos) << e2;
+  EXPECT_NE(e2.find("32767 N s"), std::string::npos) << e2;
+  EXPECT_EQ(loadError(fast, ScalarKind::Fx32), "");
+  // Inside: an 8,000 kg block dropped from 5 m (it lands at 9.9 m/s, 79,000 N s of momentum that
+  // the speculative contact removes over several sub-steps) comes to rest on the ground, and a box
+  // spun at 300 rad/s (the gyroscopic term used to overflow above ~180 rad/s) keeps stepping.
+  Scenario block = emptyWorld();
+  block.bodies.list = {box("block", half(500, 500, 500), at(0, 5500, 0), Rational{8000, 1})};
+  auto w = makeTyped<Fx16>(block);
+  for (int t = 0; t < 300; ++t) ASSERT_TRUE(w->step(TickInput{}).ok) << "block, tick " << t;
+  EXPECT_NEAR(d(w->bodies()[0].position.y()), 0.5, kSlop);
+  Scenario spin = emptyWorld();
+  spin.bodies.gravity = r3(0, 0, 0);
+  spin.bodies.list = {box("spin", half(400, 200, 100), at(0, 5000, 0), Rational{1, 1})};
+  spin.bodies.list[0].angularVelocity = {Rational{1, 1}, Rational{300, 1}, Rational{0, 1}};
+  auto v = makeTyped<Fx16>(spin);
+  for (int t = 0; t < 120; ++t) ASSERT_TRUE(v->step(TickInput{}).ok) << "spin, tick " << t;
+}
 
 // ---- islands: sleep and wake together --------------------------------------------------------------
 template <class S>

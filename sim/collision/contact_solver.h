@@ -98,8 +98,9 @@ struct ContactAxis {
   Vec3<S> dir = Vec3<S>::Zero();                             ///< unit
   Vec3<S> armA = Vec3<S>::Zero(), armB = Vec3<S>::Zero();    ///< m: rA x dir, rB x dir
   Vec3<S> turnA = Vec3<S>::Zero(), turnB = Vec3<S>::Zero();  ///< 1/(kg m): I^-1 (r x dir) of each body
-  S mass{};     ///< kg: 1 / (1/mA + 1/mB + armA.turnA + armB.turnB); 0 when immovable
-  S impulse{};  ///< N s per sub-step, accumulated
+  S invMass{};                                               ///< 1/kg: 1/mA + 1/mB + armA.turnA + armB.turnB
+  S mass{};                                                  ///< kg: 1 / invMass; 0 when immovable
+  S impulse{};                                               ///< N s per sub-step, accumulated
 };
 
 /// One contact as the solver sees it: the normal and two friction axes.

@@ -9,6 +9,41 @@
 
 namespace sg {
 namespace {
+
+/// The largest impulse fx16 holds (N s): Q16.16's largest value.
+constexpr double kFx16MaxImpulse = 32767.0;
+
+/// Why a body's mass properties do not fit S: the first of 1/mass, inertia and 1/inertia (per
+/// principal axis) beyond the range, computed in double, with what to do about it.
+template <class S>
+std::string massPropertiesOutOfRange(const BodySpec& b, const Scenario& s, const std::string& path) {
+  std::ostringstream o;
+  o << "mass properties (1/mass, inertia, 1/inertia) within the " << scalarName(ScalarTraits<S>::kind) << " range";
+  try {
+    const RigidBody<double> exact = makeBody<double>(b, s.timeStep, s.sourceName, path);
+    const double limit = ScalarTraits<S>::kind == ScalarKind::Fx16 ? kFx16MaxImpulse : 2147483647.0;
+    const char* axes = "xyz";
+    if (exact.invMass > limit) {
+      o << ", got 1/mass = " << exact.invMass << " 1/kg (lighter than " << 1 / limit << " kg)";
+    } else {
+      for (int k = 0; k < 3; ++k) {
+        if (exact.invInertiaLocal[k] > limit) {
+          o << ", got 1/inertia about " << axes[k] << " = " << exact.invInertiaLocal[k]
+            << " 1/(kg m^2): the body is too small and light (its inertia must be at least " << 1 / limit << " kg m^2)";
+          if (ScalarTraits<S>::kind == ScalarKind::Fx16) o << "; use fx32 for bodies this small (docs/fixed-point.md)";
+          return o.str();
+        }
+        if (exact.inertiaLocal[k] > limit) {
+          o << ", got inertia about " << axes[k] << " = " << exact.inertiaLocal[k] << " kg m^2";
+          return o.str();
+        }
+      }
+    }
+  } catch (const std::exception&) {
+    // The double body could not be built either: the plain message.
+  }
+  return o.str();
+}
 double d(const Rational& r) { return r.toDouble(); }
 
 std::string metres(double v) {
@@ -288,9 +323,21 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
       try {
         (void)makeBody<S>(b, s.timeStep, s.sourceName, q);
       } catch (const std::out_of_range&) {
-        throw ScenarioError(s.sourceName, q + ".mass",
-                            std::string("mass properties (1/mass, inertia, 1/inertia) within the ") +
-                                scalarName(ScalarTraits<S>::kind) + " range");
+        throw ScenarioError(s.sourceName, q + ".mass", massPropertiesOutOfRange<S>(b, s, q));
+      }
+      // fx16's rigid-body envelope (docs/fixed-point.md): an impulse is at most the format's
+      // largest value, 32,767 N s, so a body must not start with more momentum than a contact can
+      // stop (later overruns stop the tick with an overflow error naming the body).
+      if (ScalarTraits<S>::kind == ScalarKind::Fx16) {
+        double speed2 = 0;
+        for (int c = 0; c < 3; ++c) speed2 += d(b.velocity[size_t(c)]) * d(b.velocity[size_t(c)]);
+        const double momentum = d(b.mass) * std::sqrt(speed2);
+        if (momentum > kFx16MaxImpulse) {
+          std::ostringstream o;
+          o << "a momentum (mass x speed) within fx16's impulse range (<= 32767 N s; docs/fixed-point.md), got "
+            << momentum << " N s";
+          throw ScenarioError(s.sourceName, q + ".velocity", o.str());
+        }
       }
       if (takeFixedFaults() != 0)
         throw ScenarioError(s.sourceName, q + ".shape",
