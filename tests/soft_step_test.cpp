@@ -1,16 +1,19 @@
 // The soft-step contact solver on scenes the old solver failed (issue 15), in fx32, fx16 and
-// double, at the scenario defaults (4 sub-steps, 1 solve and 1 relax sweep each):
+// double, at the scenario defaults (4 sub-steps, 3 solve and 1 relax sweep each):
 //   * a stack of 20 boxes and a pyramid with a base of 10 stand;
 //   * 1000:1 mass ratios rest: a 1000 kg box on a 1 kg box, a 1 kg load on a 5 cm plank;
 //   * no tunnelling: a 0.1 m ball fired at a 1 m wall and straight down at the ground at 10 to
-//     500 m/s, a 0.2 m cube at 200 m/s, never passes (speculative contacts);
+//     500 m/s, and a 0.2 m cube likewise, never pass (speculative contacts);
 //   * islands: a stack falls asleep as one, on one tick, and wakes as one.
-// Tolerances come from the solver's constants: a resting contact keeps at most the slop
-// (settings::kLinearSlop, 5 mm) of overlap, or the body would not be allowed to sleep.
+// Tolerances come from the solver's constants: a body may fall asleep only while its contacts
+// overlap by less than the slop (settings::kLinearSlop, 5 mm), so an island that sleeps has every
+// contact within it. SIMGRASS_STACK_NOSLEEP=1 runs the stacks with sleeping off (the 20-box stack
+// then walks and falls: docs/physics-notes.md; the test fails then, by design).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -99,18 +102,23 @@ Scenario stackOf(int count) {
   // 0.5 m cubes of 1 kg, 1 mm apart (and 1 mm above the ground): they settle onto each other.
   for (int i = 0; i < count; ++i)
     s.bodies.list.push_back(box(named("box", i), half(250, 250, 250), at(0, 251 + 501 * i, 0), Rational{1, 1}));
+  if (std::getenv("SIMGRASS_STACK_NOSLEEP"))
+    for (BodySpec& b : s.bodies.list) b.canSleep = false;
   return s;
 }
 
 template <class S>
 void expectTwentyBoxStackStands(const char* name) {
-  const Drift r = standFor<S>(stackOf(20), 10.0);
-  std::printf("[stack of 20 %s] horizontal %.4f m, sink %.4f m, %s\n", name, r.horizontal, r.sink,
+  // SIMGRASS_STACK_BOXES=N stacks N instead (docs/physics-notes.md: 30 stand, 40 fall).
+  const int boxes = std::getenv("SIMGRASS_STACK_BOXES") ? std::atoi(std::getenv("SIMGRASS_STACK_BOXES")) : 20;
+  const Drift r = standFor<S>(stackOf(boxes), 10.0);
+  std::printf("[stack of %d %s] horizontal %.4f m, sink %.4f m, %s\n", boxes, name, r.horizontal, r.sink,
               r.allAsleep ? "asleep" : "awake");
-  // Each box falls through the 1 mm gaps below it (i + 1 mm for box i) and each of the 20
-  // contacts may keep the slop: the top sinks at most 20 x (1 mm + slop) = 12 cm. A fallen stack
+  // The top box falls through the 20 placement gaps of 1 mm, and each of the 20 contacts gives
+  // way under its load (g (M / m) / omega^2: 1.3 mm for the bottom one), less than the slop at
+  // which the stack could not sleep: at most 20 x (1 mm + slop) = 12 cm over the run. A fallen stack
   // drops metres.
-  EXPECT_LT(r.sink, 20 * (0.001 + kSlop)) << name;
+  EXPECT_LT(r.sink, boxes * (0.001 + kSlop)) << name;
   // Nothing pushes sideways; 2 cm (4 % of the edge) is a stack that does not walk.
   EXPECT_LT(r.horizontal, 0.02) << name;
   EXPECT_TRUE(r.allAsleep) << name << ": a standing stack falls asleep as one island";
@@ -200,7 +208,7 @@ void expectNoTunnelling(const char* name) {
     down.bodies.list[0].velocity = {Rational{0, 1}, Rational::integer(-speed), Rational{0, 1}};
     auto w = makeTyped<S>(s);
     auto g = makeTyped<S>(down);
-    double ballMost = -1e9, cubeMost = -1e9, lowest = 1e9;
+    double ballMost = -1e9, cubeMost = -1e9, lowest = 1e9;  // m past the face (< 0: short of it)
     for (int t = 0; t < 120; ++t) {
       const StepResult r1 = w->step(TickInput{}), r2 = g->step(TickInput{});
       ASSERT_TRUE(r1.ok && r2.ok) << name << " " << speed << " m/s tick " << t << ": " << r1.error.message() << " "
@@ -219,6 +227,10 @@ void expectNoTunnelling(const char* name) {
     EXPECT_LT(ballMost, kSlop + 0.01) << name << " " << speed << " m/s: the ball";
     EXPECT_LT(cubeMost, 0.05) << name << " " << speed << " m/s: the cube";
     EXPECT_GT(lowest, -(kSlop + 0.01)) << name << " " << speed << " m/s: into the ground";
+    // ... and each did reach its surface (a contact that stopped it early passes the bounds above).
+    EXPECT_GT(ballMost, -0.01) << name << " " << speed << " m/s: the ball stopped short of the wall";
+    EXPECT_GT(cubeMost, -0.01) << name << " " << speed << " m/s: the cube stopped short of the wall";
+    EXPECT_LT(lowest, 0.01) << name << " " << speed << " m/s: the ball stopped above the ground";
   }
 }
 TEST(SoftStep, NothingTunnelsUpTo500MetresPerSecondFx32) { expectNoTunnelling<Fx32>("fx32"); }
@@ -270,17 +282,55 @@ void expectEnergyNeverRises(const char* name) {
     // Semi-implicit Euler loses g^2 h^2 / 2 per unit mass and sub-step in flight; impacts lose
     // (1 - e^2); a soft contact pushing a deep overlap out raises the potential energy by at most
     // what the fall into it released. The sum never exceeds the start: measured -0.26 J of
-    // 4,697 J (the first tick's loss). The allowance, 1e-6 of E0, is rounding of the sums in
-    // fixed point (positions to 2^-16 m in fx16: 1e-3 J over 78 kg and 10 m).
+    // 4,697 J (the first tick's loss). The allowance is rounding: 1e-6 of E0 for the double sums,
+    // and in fixed point each body's height rounded to a unit (2^-16 m in fx16: 78 kg x g x unit =
+    // 0.012 J). A pile that gained any energy of its own beyond that fails.
     double unit = 0;
     if constexpr (ScalarTraits<S>::isFixed) unit = d(S::fromRaw(1));
-    EXPECT_LE(most, 1e-6 * e0 + 80 * 9.81 * unit * 10)
+    EXPECT_LE(most, 1e-6 * e0 + 78 * 9.81 * unit)
         << name << " e = " << tenths << "/10: energy rose by " << most << " J of " << e0;
   }
 }
 TEST(SoftStep, EnergyNeverRisesInAClosedSystemFx32) { expectEnergyNeverRises<Fx32>("fx32"); }
 TEST(SoftStep, EnergyNeverRisesInAClosedSystemFx16) { expectEnergyNeverRises<Fx16>("fx16"); }
 TEST(SoftStep, EnergyNeverRisesInAClosedSystemDouble) { expectEnergyNeverRises<double>("double"); }
+
+// ---- a still body that waits for its island saves and restores ---------------------------------------
+// A box resting on one that may never sleep (canSleep false) is still but cannot sleep: its
+// still-tick count must stop at the sleep time (the state format's bound), or a save after half
+// a second no longer loads.
+template <class S>
+void expectWaitingBodySavesAndRestores(const char* name) {
+  Scenario s = emptyWorld();
+  s.bodies.list = {box("support", half(250, 250, 250), at(0, 251, 0), Rational{1, 1}),
+                   box("load", half(250, 250, 250), at(0, 752, 0), Rational{1, 1})};
+  s.bodies.list[0].canSleep = false;
+  auto w = makeTyped<S>(s);
+  for (int t = 0; t < 120; ++t) ASSERT_TRUE(w->step(TickInput{}).ok);
+  EXPECT_FALSE(w->bodies()[1].asleep) << name << ": its island holds a body that may not sleep";
+  const auto saved = w->saveState();
+  auto copy = makeTyped<S>(s);
+  ASSERT_NO_THROW(copy->restoreState(saved)) << name;
+  for (int t = 0; t < 60; ++t) {
+    ASSERT_TRUE(w->step(TickInput{}).ok);
+    ASSERT_TRUE(copy->step(TickInput{}).ok);
+  }
+  EXPECT_EQ(w->stateHash(), copy->stateHash()) << name;
+}
+TEST(SoftStep, AStillBodyWaitingForItsIslandSavesAndRestoresFx32) { expectWaitingBodySavesAndRestores<Fx32>("fx32"); }
+TEST(SoftStep, AStillBodyWaitingForItsIslandSavesAndRestoresDouble) {
+  expectWaitingBodySavesAndRestores<double>("double");
+}
+
+// ---- five boxes stand without sleeping --------------------------------------------------------------
+TEST(SoftStep, FiveBoxStackStandsTwentySecondsWithoutSleepFx32) {
+  Scenario s = stackOf(5);
+  for (BodySpec& b : s.bodies.list) b.canSleep = false;
+  const Drift r = standFor<Fx32>(s, 20.0);
+  std::printf("[stack of 5, no sleep, fx32] horizontal %.4f m, sink %.4f m\n", r.horizontal, r.sink);
+  EXPECT_LT(r.horizontal, 0.005);  // measured 1.0 mm: nothing pushes sideways
+  EXPECT_LT(r.sink, 5 * (0.001 + kSlop));
+}
 
 // ---- fx16's rigid-body envelope (docs/fixed-point.md) ---------------------------------------------
 std::string loadError(Scenario s, ScalarKind scalar) {
@@ -312,8 +362,17 @@ TEST(SoftStep, Fx16EnvelopeIsCheckedAtLoadAndHoldsInside) {
   EXPECT_NE(e2.find("$.bodies.list[0].velocity"), std::string::npos) << e2;
   EXPECT_NE(e2.find("32767 N s"), std::string::npos) << e2;
   EXPECT_EQ(loadError(fast, ScalarKind::Fx32), "");
-  // Inside: an 8,000 kg block dropped from 5 m (it lands at 9.9 m/s, 79,000 N s of momentum that
-  // the speculative contact removes over several sub-steps) comes to rest on the ground, and a box
+  // The sub-step rate substeps / timeStep must fit too: 64 sub-steps of a 1 ms tick is 64,000 /s.
+  Scenario rate = emptyWorld();
+  rate.timeStep = Rational{1, 1000};
+  rate.bodies.substeps = 64;
+  rate.bodies.list = {test::sphere("ball", mm(100), at(0, 1000, 0))};
+  const std::string e3 = loadError(rate, ScalarKind::Fx16);
+  EXPECT_NE(e3.find("$.bodies.substeps"), std::string::npos) << e3;
+  EXPECT_EQ(loadError(rate, ScalarKind::Fx32), "");
+  // Inside: an 8,000 kg block dropped from 5 m (it lands at 9.9 m/s, 79,000 N s of momentum; each
+  // of its four corner rows carries a quarter of it, split over at most two sub-steps) comes to
+  // rest on the ground, and a box
   // spun at 300 rad/s (the gyroscopic term used to overflow above ~180 rad/s) keeps stepping.
   Scenario block = emptyWorld();
   block.bodies.list = {box("block", half(500, 500, 500), at(0, 5500, 0), Rational{8000, 1})};

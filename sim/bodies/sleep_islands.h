@@ -6,6 +6,7 @@
 // comparisons and a union-find whose roots depend only on the canonical contact order.
 #pragma once
 
+#include <algorithm>
 #include <numeric>
 #include <vector>
 
@@ -48,11 +49,13 @@ inline std::vector<int32_t> contactIslands(size_t bodyCount, const std::vector<C
 template <class S>
 inline void updateSleep(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts, S linearThreshold,
                         S angularThreshold, int32_t ticksToSleep) {
+  // The count saturates at ticksToSleep (a still body in an island that is not ready waits there;
+  // the state format allows 0..ticksToSleep), and a body that may never sleep keeps 0.
   for (RigidBody<S>& b : bodies) {
-    if (b.asleep) continue;
+    if (b.asleep || !b.canSleep) continue;
     const bool still =
         b.heldThisTick && slowerThan(b.velocity, linearThreshold) && slowerThan(b.angularVelocity, angularThreshold);
-    b.stillTicks = still ? b.stillTicks + 1 : 0;
+    b.stillTicks = still ? std::min(b.stillTicks + 1, ticksToSleep) : 0;
   }
   const std::vector<int32_t> island = contactIslands(bodies.size(), contacts);
   std::vector<uint8_t> ready(bodies.size(), 1);  // per root: every member may sleep now

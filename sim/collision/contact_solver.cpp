@@ -232,7 +232,8 @@ void solveContacts(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>
       row.impactGap = maxS(s, S(0));
     }
     row.maxImpulseN = maxS(row.maxImpulseN, total);
-    // Friction: stop the sliding velocity, within the Coulomb cone mu * normal impulse.
+    // Friction: stop the sliding velocity, each tangent within +-mu x normal impulse (a friction
+    // pyramid, as Box2D and Jolt clamp it: diagonal sliding may get up to sqrt(2) mu N).
     const S limit = row.friction * n.impulse;
     for (ContactAxis<S>* t : {&row.t1, &row.t2}) {
       const S wanted = t->impulse - axisVelocity(bodies, row, *t) * t->mass;
@@ -246,8 +247,8 @@ void solveContacts(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>
 template <class S>
 void applyRestitution(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows,
                       const SolverSettings<S>& settings) {
-  // Against the normal velocity the contact met when it first pushed (before that sub-step's
-  // solve), and only where it pushed (a contact that merely grazed bounces nothing).
+  // Against the fastest approach a pushing solve met (before its impulse), and only where the
+  // contact pushed (a contact that merely grazed bounces nothing).
   for (ContactRow<S>& row : rows) {
     if (!(row.maxImpulseN > S(0)) || !(row.impactVelocity < -settings.restitutionThreshold)) continue;
     if (row.restitution == S(0)) continue;
@@ -256,7 +257,7 @@ void applyRestitution(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<
     // surface (it then rests on it for the rest of the tick): against the terrain, gravity
     // would have sped it up over that gap, so the impact speed gets the gain of
     // v^2 = V^2 + 2 g_n gap (first order: V + g_n gap / V; gap <= V h keeps the neglected term
-    // below (g h / V)^2 / 2, 0.4 % at the 1 m/s threshold and 60 Hz x 4). Without it an elastic
+    // below (g h / V)^2 / 2 of V, 0.08 % at the 1 m/s threshold and 60 Hz x 4). Without it an elastic
     // ball lost m g_n gap, half a sub-step of fall on average, every bounce (a third of its height
     // in a minute). Between two bodies gravity pulls both alike: no relative gain.
     S impactSpeed = -row.impactVelocity;

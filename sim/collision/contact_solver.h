@@ -62,7 +62,7 @@ Softness<S> makeSoftness(S hertz, S zeta, S h, S pi);
 template <class S>
 struct SolverSettings {
   int substeps = 4;                   ///< sub-steps per tick (the scenario's bodies.substeps)
-  int solveIterations = 1;            ///< solve sweeps per sub-step (bodies.velocityIterations)
+  int solveIterations = 3;            ///< solve sweeps per sub-step (bodies.velocityIterations)
   int relaxIterations = 1;            ///< relax sweeps per sub-step (bodies.positionIterations)
   S restitutionThreshold{};           ///< m/s
   S maxPushVelocity{};                ///< m/s: the fastest a soft contact pushes overlap out
@@ -107,9 +107,10 @@ struct ContactAxis {
 template <class S>
 struct ContactRow {
   ContactAxis<S> normal, t1, t2;
-  Vec3<S> localA, localB;  ///< m: contact point from each centre of mass in the body's frame (turns with it)
-  Vec3<S> anchorGap;       ///< m: A's anchor - B's anchor (terrain: A's alone) at prepare; s starts exact
-  S separation{};          ///< m at prepare: minus the penetration (> 0: speculative)
+  Vec3<S> localA = Vec3<S>::Zero(),
+          localB = Vec3<S>::Zero();     ///< m: contact point from each centre of mass, body frame
+  Vec3<S> anchorGap = Vec3<S>::Zero();  ///< m: A's anchor - B's anchor (terrain: A's alone) at prepare; s starts exact
+  S separation{};                       ///< m at prepare: minus the penetration (> 0: speculative)
   S invMassA{}, invMassB{};
   S impactVelocity{};  ///< m/s: the most negative normal velocity a pushing solve met this tick
   S impactGap{};       ///< m: the separation (>= 0) when it did (a speculative stop short of the surface)

@@ -15,7 +15,10 @@ template <class S>
 void World<S>::detectContacts() {
   contacts_.clear();
   // How far each body can move this tick, (|v| + |w| r + |g| dt) dt (m): pairs and terrain that
-  // close within it get speculative contacts, so nothing passes through anything in one tick.
+  // close within it get speculative contacts, so no body passes through another, or through the
+  // terrain below it, in one tick. (The terrain test looks under the body's present position: a
+  // fast sideways flight into a steep heightmap slope is not covered; nor is a body sped up
+  // beyond its reach by another within the tick.)
   const S dt = particleConsts_.dt;
   const S gravityGain = length3(gravityDt_.x(), gravityDt_.y(), gravityDt_.z());
   std::vector<S> reach(bodies_.size(), S(0)), grown(bodies_.size(), S(0));

@@ -158,8 +158,9 @@ struct Scenario {
 
   struct Bodies {
     Rational3 gravity{Rational{0, 1}, Rational{-981, 100}, Rational{0, 1}};  ///< m/s^2
-    /// The soft step (sim/collision/contact_solver.h): sub-steps per tick, and solve and relax
-    /// sweeps per sub-step (Box2D v3's defaults: 4, 1, 1).
+    /// The soft step (sim/collision/contact_solver.h): sub-steps per tick (4, as Box2D v3), and
+    /// solve and relax sweeps per sub-step (3 and 1: with Box2D's 1 solve sweep a 20-box stack
+    /// falls, docs/physics-notes.md).
     int substeps = 4;
     int velocityIterations = 3;  ///< solve sweeps per sub-step
     int positionIterations = 1;  ///< relax sweeps per sub-step (0: the push velocity stays)

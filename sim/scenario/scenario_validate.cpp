@@ -105,6 +105,8 @@ void checkResolution(const Scenario& s) {
           std::string(what) + " that does not round to zero in " + scalarName(T::kind) + ", got " + r.toString());
   };
   nonZero(s.timeStep, "$.timeStep", "a time step");
+  if (!s.bodies.list.empty())  // the soft step's sub-step h = timeStep / substeps (world.cpp)
+    nonZero(*div(s.timeStep, Rational{s.bodies.substeps, 1}), "$.bodies.substeps", "a sub-step (timeStep / substeps)");
   nonZero(s.field.spacing, "$.field.spacing", "a spacing");
   nonZero(s.particles.constraintLength, "$.particles.constraintLength", "a constraint length");
   nonZero(s.wind.travelSpeed, "$.wind.travelSpeed", "a travel speed");
@@ -247,6 +249,8 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
     fits(pa.mass, "$.particles.mass");
     fits(derived.invMass, "$.particles.mass", "1/mass");
     fits(derived.invDt, "$.timeStep", "1/timeStep");
+    if (!s.bodies.list.empty())
+      fits(*div(Rational{s.bodies.substeps, 1}, s.timeStep), "$.bodies.substeps", "substeps/timeStep");
     fits(derived.halfRod, "$.particles.constraintLength", "constraintLength/2");
     fits(derived.jitterAmplitude, "$.field.jitter", "jitter x spacing");
     fits(derived.fieldOriginX, "$.field.center[0]", "field corner x");

@@ -26,12 +26,14 @@ inline constexpr Exact kContactPushMaxVelocity{3, 1};
 /// Shapes this close (m) get speculative contacts even when nothing moves (Box2D's
 /// b2_speculativeDistance, 4 x its 5 mm slop): a resting contact that opens by rounding or a
 /// small hop keeps its row and its warm-start impulses. The world adds each body's motion in
-/// the tick, (|v| + |g| dt) dt, for continuous collision.
+/// the tick, (|v| + |w| r + |g| dt) dt, for continuous collision.
 inline constexpr Exact kSpeculativeDistance{1, 50};
-/// Overlap a resting contact may keep (m, Box2D's b2_linearSlop): a body with a contact deeper
-/// than this is still being pushed out (at up to kContactPushMaxVelocity, a motion the relax pass
-/// hides from its velocity), so it may not fall asleep: a sphere started 1.5 m under the ground
-/// fell asleep 8 cm inside it.
+/// Overlap above which a body counts as being pushed out (m, Box2D's b2_linearSlop). The solver
+/// itself has no slop (soft contacts settle to their load's give); only the sleep rule reads it:
+/// a body with a contact deeper than this is moving at up to kContactPushMaxVelocity, a motion
+/// the relax pass hides from its velocity, so it may not fall asleep (a sphere started 1.5 m under
+/// the ground fell asleep 8 cm inside it). A contact that gives more than this under a heavy
+/// load (1000 kg on a 1 kg box) keeps its island awake.
 inline constexpr Exact kLinearSlop{1, 200};
 /// pi for the soft constraints' 2 pi hertz (355/113: 3e-7 relative, far below what a stiffness
 /// needs; an exact fraction, so every scalar rounds it once).
