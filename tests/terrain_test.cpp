@@ -1,5 +1,5 @@
-// Terrain: exact heights at the samples, bilinear in between, analytic normals on a plane, edge
-// clamping, and patch roots on the ground.
+// Terrain: exact heights at the samples, two planar triangles per cell in between (split along
+// the anti-diagonal), analytic normals on a plane, edge clamping, and patch roots on the ground.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -44,9 +44,38 @@ TEST(Terrain, ExactHeightsAtSamplesFx32) {
     }
 }
 
-TEST(Terrain, BilinearBetweenSamplesDouble) {
+// One raised sample in a 3 x 3 map (cell 1 m, centred): the cell [0, 1] x [0, 1] (samples 1..2)
+// has samples h00 = 0, h10 = 0, h01 = 0, h11 = 1 m. Split along 10-01, its lower triangle is the
+// plane h = 0 and its upper the plane h = tx + tz - 1; a bilinear patch would give tx tz.
+TEST(Terrain, EachCellIsTwoPlanarTrianglesDouble) {
+  Scenario::Terrain m;
+  m.flat = false;
+  m.cellSize = Rational{1, 1};
+  m.maxHeight = Rational{1, 1};
+  m.heightmap.width = m.heightmap.height = 3;
+  m.heightmap.samples = {0, 0, 0, 0, 0, 0, 0, 0, 255};
+  Terrain<double> t = terrainOf<double>(m);
+  for (double tx = 0.05; tx < 1; tx += 0.1)
+    for (double tz = 0.05; tz < 1; tz += 0.1) {
+      if (std::fabs(tx + tz - 1) < 1e-6) continue;  // on the diagonal: either face's normal
+      const double expected = tx + tz < 1 ? 0.0 : tx + tz - 1;
+      EXPECT_NEAR(t.heightAt(tx, tz), expected, 1e-12) << tx << "," << tz;
+      double nx = 0, ny = 0, nz = 0;
+      t.normalAt(tx, tz, &nx, &ny, &nz);
+      const double s = tx + tz < 1 ? 0.0 : 1.0;  // the upper triangle rises 1 m per m along x and z
+      EXPECT_NEAR(nx, -s / std::sqrt(1 + 2 * s * s), 1e-12);
+      EXPECT_NEAR(ny, 1 / std::sqrt(1 + 2 * s * s), 1e-12);
+      EXPECT_NEAR(nz, -s / std::sqrt(1 + 2 * s * s), 1e-12);
+    }
+  // Continuous across the diagonal and the cell edges.
+  EXPECT_NEAR(t.heightAt(0.3, 0.7), 0.0, 1e-12);
+  EXPECT_NEAR(t.heightAt(1.0, 0.5), 0.5, 1e-12);
+  EXPECT_NEAR(t.heightAt(0.5, 1.0), 0.5, 1e-12);
+}
+
+TEST(Terrain, PlanarRampIsReproducedBetweenSamplesDouble) {
   Terrain<double> t = terrainOf<double>(rampTerrain(9, 5));
-  // The ramp is linear (h = (4x + z) / 50 in sample units): bilinear reproduces it everywhere.
+  // The ramp is linear (h = (4x + z) / 50 in sample units): the triangles reproduce it everywhere.
   for (double wx = -1.9; wx < 1.9; wx += 0.173)
     for (double wz = -0.9; wz < 0.9; wz += 0.131) {
       const double x = wx / 0.5 + 4, z = wz / 0.5 + 2;

@@ -11,6 +11,7 @@
 #include "sim/bodies/rigid_body.h"
 #include "sim/collision/box_box.h"
 #include "sim/collision/primitives.h"
+#include "sim/collision/terrain_contacts.h"
 
 namespace sg {
 

@@ -15,6 +15,50 @@ Vec3<S> tangentOf(const Vec3<S>& n) {
   return t / length3(t.x(), t.y(), t.z());
 }
 
+/// m/s: a contact whose bodies slide past each other faster than this at prepare takes its
+/// first friction axis along that sliding (Bullet does the same). The cone (solveContacts) is
+/// round whatever the axes, but the sweep is not: t1 takes its impulse before t2 sees it, and
+/// the projection scales that pair, so with fixed axes 45 deg to the slide a box slid 1.5 % too
+/// far and drifted 1.6 cm sideways in a metre. Slower contacts (resting ones) keep the fixed
+/// axes, so warm-started static friction does not turn with rounding noise. 1 cm/s: 655 units
+/// of fx16, a clean direction.
+template <class S>
+S slidingAxisSpeed() {
+  return S(1) / S(100);
+}
+
+/// The first friction axis of a contact: along the tangential part of A's velocity against B's
+/// (or the ground's) when that slides (*sliding = true), else tangentOf(n). The centres'
+/// velocities, not the contact points': every contact of a pair then turns its axes on the same
+/// tick and the same way (per point, corners crossing the speed on different ticks mixed axes
+/// and set a sliding box spinning).
+template <class S>
+Vec3<S> frictionDirection(const Vec3<S>& n, const RigidBody<S>& A, const RigidBody<S>* B, bool* sliding) {
+  Vec3<S> v = A.velocity;
+  if (B) v -= B->velocity;
+  const Vec3<S> tangential = v - n * n.dot(v);
+  *sliding = false;
+  const S speed = slidingAxisSpeed<S>();
+  if (abs(tangential.x()) < speed && abs(tangential.y()) < speed && abs(tangential.z()) < speed) return tangentOf(n);
+  const S length = length3(tangential.x(), tangential.y(), tangential.z());
+  if (!(length > speed)) return tangentOf(n);
+  *sliding = true;
+  return tangential / length;
+}
+
+/// v clamped to [-limit, limit].
+template <class S>
+S clampMagnitude(S v, S limit) {
+  return v < -limit ? -limit : (v > limit ? limit : v);
+}
+
+/// sqrt of a non-negative v (0 for a rounding-negative one).
+template <class S>
+S sqrtS(S v) {
+  using std::sqrt;
+  return v > S(0) ? S(sqrt(v)) : S(0);
+}
+
 /// The axis `dir` of a contact at arms rA (and rB unless B is the terrain).
 template <class S>
 ContactAxis<S> makeAxis(const Vec3<S>& dir, const RigidBody<S>& A, const Vec3<S>& rA, const RigidBody<S>* B,
@@ -136,6 +180,12 @@ void matchCachedImpulses(const std::vector<Contact<S>>& contacts, const std::vec
     rows[i].normal.impulse = hit.normal;
     rows[i].t1.impulse = hit.tangent1;
     rows[i].t2.impulse = hit.tangent2;
+    if (rows[i].slidingAxes) {  // the cache holds the fixed axes' impulses: turn them onto the sliding axes
+      const Vec3<S> fixed1 = tangentOf(rows[i].normal.dir), fixed2 = rows[i].normal.dir.cross(fixed1);
+      const Vec3<S> friction = fixed1 * hit.tangent1 + fixed2 * hit.tangent2;
+      rows[i].t1.impulse = friction.dot(rows[i].t1.dir);
+      rows[i].t2.impulse = friction.dot(rows[i].t2.dir);
+    }
   }
 }
 
@@ -168,7 +218,7 @@ void prepareContacts(const std::vector<RigidBody<S>>& bodies, const std::vector<
     const Vec3<S> rB = B ? Vec3<S>(c.point - B->position) : Vec3<S>(Vec3<S>::Zero());
     row.localA = A.rotation.transpose() * rA;
     if (B) row.localB = B->rotation.transpose() * rB;
-    const Vec3<S> t1 = tangentOf(c.normal);
+    const Vec3<S> t1 = frictionDirection(c.normal, A, B, &row.slidingAxes);
     row.normal = makeAxis(c.normal, A, rA, B, rB);
     row.t1 = makeAxis(t1, A, rA, B, rB);
     row.t2 = makeAxis(Vec3<S>(c.normal.cross(t1)), A, rA, B, rB);
@@ -232,15 +282,46 @@ void solveContacts(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>
       row.impactGap = maxS(s, S(0));
     }
     row.maxImpulseN = maxS(row.maxImpulseN, total);
-    // Friction: stop the sliding velocity, each tangent within +-mu x normal impulse (a friction
-    // pyramid, as Box2D and Jolt clamp it: diagonal sliding may get up to sqrt(2) mu N).
+    // Friction: stop the sliding velocity, the tangent impulse kept inside the Coulomb cone
+    // |t| <= mu x normal impulse. Per-axis clamps (a pyramid) gave up to sqrt(2) mu N along the
+    // diagonals and not opposite the velocity: a box on a slope 27 deg off its tangent axes slid
+    // along one axis only, and a box 45 deg off held at 1.3 times its friction angle.
     const S limit = row.friction * n.impulse;
-    for (ContactAxis<S>* t : {&row.t1, &row.t2}) {
-      const S wanted = t->impulse - axisVelocity(bodies, row, *t) * t->mass;
-      const S clamped = wanted < -limit ? -limit : (wanted > limit ? limit : wanted);
-      applyAxisImpulse(bodies, row, *t, S(clamped - t->impulse));
-      t->impulse = clamped;
+    const S wanted1 = row.t1.impulse - axisVelocity(bodies, row, row.t1) * row.t1.mass;
+    if (row.slidingAxes) {
+      // Sliding: t1 is along the slide and comes first, up to the whole cone; t2 (across) gets
+      // what is left. Scaling the pair instead let the corners of a sliding box keep sideways
+      // impulses that cancel between them (nothing in the sweep removes those) at 6 % of the
+      // cone: the box slid with 94 % of its kinetic friction, 4 times too far near the
+      // friction angle.
+      const S total1 = clampMagnitude(wanted1, limit);
+      applyAxisImpulse(bodies, row, row.t1, S(total1 - row.t1.impulse));
+      row.t1.impulse = total1;
+      const S wanted2 = row.t2.impulse - axisVelocity(bodies, row, row.t2) * row.t2.mass;
+      const S used = abs(total1);
+      // sqrt(limit^2 - t1^2) as a product of roots: (limit - |t1|)(limit + |t1|) of an 8 t block's
+      // impulses overflows fx16.
+      const S left = sqrtS(S(limit - used)) * sqrtS(S(limit + used));
+      const S total2 = clampMagnitude(wanted2, left);
+      applyAxisImpulse(bodies, row, row.t2, S(total2 - row.t2.impulse));
+      row.t2.impulse = total2;
+      continue;
     }
+    // At rest (fixed axes): both axes' targets from the same velocity (a sequential t1 then t2
+    // turns the pair's direction towards t1, which near the friction angle let a box slip 6 %
+    // further on the diagonal), the pair scaled onto the cone (Jolt clamps the pair the same way).
+    const S wanted2 = row.t2.impulse - axisVelocity(bodies, row, row.t2) * row.t2.mass;
+    S total1 = wanted1, total2 = wanted2;
+    const S length = length3(wanted1, wanted2, S(0));
+    if (length > limit) {
+      const S scale = limit / length;  // length > limit >= 0: scale < 1
+      total1 = wanted1 * scale;
+      total2 = wanted2 * scale;
+    }
+    applyAxisImpulse(bodies, row, row.t1, S(total1 - row.t1.impulse));
+    row.t1.impulse = total1;
+    applyAxisImpulse(bodies, row, row.t2, S(total2 - row.t2.impulse));
+    row.t2.impulse = total2;
   }
 }
 
@@ -277,36 +358,51 @@ template <class S>
 void storeImpulses(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
                    const std::vector<ContactRow<S>>& rows, const SolverSettings<S>& settings,
                    std::vector<CachedImpulse<S>>& cache) {
-  // Sliding: a body whose contacts' friction, summed, reached the summed Coulomb limits (a
-  // tangent impulse at +-mu x normal impulse is saturated). Such a body is not held by its
-  // contacts: a box a quarter degree past its friction angle accelerates at 4 cm/s^2, slow enough
-  // for the speed test, yet it must slide on. Summed per body, not per contact: one corner of a
-  // resting box may saturate while the others hold it (fx16 rounding did that).
+  // Sliding: a body whose contacts' friction, added up as a vector, reached the sum of their
+  // Coulomb limits (every contact at its limit, all pulling the same way). Such a body is not
+  // held by its contacts: a box a quarter degree past its friction angle accelerates at 4 cm/s^2,
+  // slow enough for the speed test, yet it must slide on. As a vector, because the corners of a
+  // resting box may carry friction that cancels between them (the solver has no reason to
+  // remove it, and fx16 rounding grows it to the corners' limits) while the body is held with a
+  // margin. Within 1/256 of the sum counts as at it: fx16 rounds a saturated box's sum to
+  // 0.9984..1.0016 of it, and a box held a quarter degree inside its friction angle (needing
+  // 97 %) to at most 0.987 of it.
   // Overlapping deeper than the slop: still being pushed out, however small its velocity.
-  std::vector<S> friction(bodies.size(), S(0)), limit(bodies.size(), S(0));
+  std::vector<Vec3<S>> friction(bodies.size(), Vec3<S>::Zero());
+  std::vector<S> limit(bodies.size(), S(0));
   std::vector<uint8_t> deep(bodies.size(), 0);
   for (const ContactRow<S>& row : rows) {
     if (row.separation < -settings.linearSlop) {
       deep[size_t(row.a)] = 1;
       if (row.b != kTerrainBody) deep[size_t(row.b)] = 1;
     }
-    const S used = maxS(abs(row.t1.impulse), abs(row.t2.impulse));
+    const Vec3<S> force = row.t1.dir * row.t1.impulse + row.t2.dir * row.t2.impulse;  // on A; -force on B
     const S most = row.friction * row.normal.impulse;
-    for (const int32_t id : {row.a, row.b}) {
-      if (id == kTerrainBody) continue;
-      friction[size_t(id)] += used;
-      limit[size_t(id)] += most;
+    friction[size_t(row.a)] += force;
+    limit[size_t(row.a)] += most;
+    if (row.b != kTerrainBody) {
+      friction[size_t(row.b)] -= force;
+      limit[size_t(row.b)] += most;
     }
   }
   for (size_t i = 0; i < bodies.size(); ++i) {
-    const bool sliding = limit[i] > S(0) && !(friction[i] < limit[i]);
+    const Vec3<S>& f = friction[i];
+    const bool sliding = limit[i] > S(0) && !(length3(f.x(), f.y(), f.z()) < limit[i] - limit[i] / S(256));
     bodies[i].heldThisTick = !sliding && !deep[i];
   }
   cache.clear();
-  for (size_t i = 0; i < rows.size(); ++i)
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const ContactRow<S>& row = rows[i];
+    S tangent1 = row.t1.impulse, tangent2 = row.t2.impulse;
+    if (row.slidingAxes) {  // back onto the fixed axes, which the next tick's rows start from
+      const Vec3<S> fixed1 = tangentOf(row.normal.dir), fixed2 = row.normal.dir.cross(fixed1);
+      const Vec3<S> friction = row.t1.dir * row.t1.impulse + row.t2.dir * row.t2.impulse;
+      tangent1 = friction.dot(fixed1);
+      tangent2 = friction.dot(fixed2);
+    }
     cache.push_back(CachedImpulse<S>{contacts[i].bodyA, contacts[i].bodyB, contacts[i].featureA, contacts[i].featureB,
-                                     rows[i].normal.impulse, rows[i].t1.impulse, rows[i].t2.impulse,
-                                     contacts[i].point});
+                                     row.normal.impulse, tangent1, tangent2, contacts[i].point});
+  }
 }
 
 #define SG_INSTANTIATE(S)                                                                                            \

@@ -117,6 +117,7 @@ struct ContactRow {
   S restitution{}, friction{};
   S maxImpulseN{};  ///< the largest normal impulse of any sub-step (did it push?)
   int32_t a = 0, b = kTerrainBody;
+  bool slidingAxes = false;  ///< t1 along the sliding velocity at prepare (else tangentOf(normal))
 };
 
 /// Builds the rows of `contacts` from the bodies as they are before this tick's gravity, and

@@ -60,82 +60,11 @@ int collideSphereBox(int32_t a, const Vec3<S>& ca, S ra, int32_t b, const Vec3<S
   return 1;
 }
 
-template <class S>
-int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& terrain, std::vector<Contact<S>>& out,
-                         S speculative) {
-  const S h = terrain.heightAt(ca.x(), ca.z());
-  if (ca.y() - h >= ra + ra + speculative) return 0;  // far above: not even a steep slope can touch
-  Vec3<S> n;
-  terrain.normalAt(ca.x(), ca.z(), &n.x(), &n.y(), &n.z());
-  // Distance from the centre to the tangent plane through (x, h, z).
-  const S dist = (ca.y() - h) * n.y();
-  if (dist >= ra + speculative) return 0;
-  Contact<S> c;
-  c.bodyA = a;
-  c.bodyB = kTerrainBody;
-  c.normal = n;
-  c.penetration = ra - dist;
-  c.point = ca - n * minS(dist, ra);  // speculative: the sphere's lowest point, not the ground far below
-  out.push_back(c);
-  return 1;
-}
-
-template <class S>
-int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Terrain<S>& terrain,
-                      std::vector<Contact<S>>& out, S speculative) {
-  int added = 0;
-  // 1. Corners below the terrain (thesis).
-  for (uint32_t corner = 0; corner < 8; ++corner) {
-    const Vec3<S> local((corner & 1) ? ha.x() : -ha.x(), (corner & 2) ? ha.y() : -ha.y(),
-                        (corner & 4) ? ha.z() : -ha.z());
-    const Vec3<S> p = pa.toWorld(local);
-    const S h = terrain.heightAt(p.x(), p.z());
-    if (p.y() - h >= speculative) continue;  // the vertical gap bounds the gap along the normal
-    Vec3<S> n;
-    terrain.normalAt(p.x(), p.z(), &n.x(), &n.y(), &n.z());
-    Contact<S> c;
-    c.bodyA = a;
-    c.bodyB = kTerrainBody;
-    c.featureA = corner;
-    c.normal = n;
-    c.penetration = (h - p.y()) * n.y();
-    c.point = p;
-    out.push_back(c);
-    ++added;
-  }
-  // 2. Terrain samples inside the box (ridges between the corners).
-  std::vector<std::pair<S, S>> samples;
-  terrain.samplesInside(pa.position.x(), pa.position.z(), ha.norm(), samples);
-  for (size_t i = 0; i < samples.size(); ++i) {
-    const Vec3<S> p(samples[i].first, terrain.heightAt(samples[i].first, samples[i].second), samples[i].second);
-    const Vec3<S> local = pa.toLocal(p);
-    if (abs(local.x()) >= ha.x() || abs(local.y()) >= ha.y() || abs(local.z()) >= ha.z()) continue;
-    S best, side;
-    const int axis = nearestFaceAxis(local, ha, &best, &side);
-    Vec3<S> face = Vec3<S>::Zero();
-    face[axis] = side;
-    Contact<S> c;
-    c.bodyA = a;
-    c.bodyB = kTerrainBody;
-    c.featureA = 8 + uint32_t(2 * axis + (local[axis] < S(0) ? 1 : 0));
-    c.featureB = uint32_t(i);
-    c.normal = -(pa.rotation * face);  // the terrain pushes the box away from that face
-    c.penetration = best;
-    c.point = p;
-    out.push_back(c);
-    ++added;
-  }
-  return added;
-}
-
-#define SG_INSTANTIATE(S)                                                                                              \
-  template int collideSphereSphere(int32_t, const Vec3<S>&, S, int32_t, const Vec3<S>&, S, std::vector<Contact<S>>&,   \
-                                   S);                                                                                 \
-  template int collideSphereBox(int32_t, const Vec3<S>&, S, int32_t, const Vec3<S>&, const Pose<S>&,                   \
-                                std::vector<Contact<S>>&, S);                                                          \
-  template int collideSphereTerrain(int32_t, const Vec3<S>&, S, const Terrain<S>&, std::vector<Contact<S>>&, S);       \
-  template int collideBoxTerrain(int32_t, const Vec3<S>&, const Pose<S>&, const Terrain<S>&, std::vector<Contact<S>>&, \
-                                 S);
+#define SG_INSTANTIATE(S)                                                                                            \
+  template int collideSphereSphere(int32_t, const Vec3<S>&, S, int32_t, const Vec3<S>&, S, std::vector<Contact<S>>&, \
+                                   S);                                                                               \
+  template int collideSphereBox(int32_t, const Vec3<S>&, S, int32_t, const Vec3<S>&, const Pose<S>&,                 \
+                                std::vector<Contact<S>>&, S);
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE)
 #undef SG_INSTANTIATE
 }  // namespace sg

@@ -1,16 +1,15 @@
-// Narrow phase for spheres and against the terrain (thesis §4 "Collision detection"). Box-box is
-// in box_box.h. Every routine appends contacts with the conventions of contact.h (normal from B
-// to A) and never divides by zero: coincident centres get a fixed normal.
-// `speculative` (m, >= 0): shapes up to that far apart get a contact too, with a negative
-// penetration (the gap). The solver lets such a contact close at most its gap per step
-// (speculative contacts, Box2D v3), so a body that would pass through within a tick stops at the
+// Narrow phase for spheres (thesis §4 "Collision detection"). Box-box is in box_box.h, bodies
+// against the terrain in terrain_contacts.h. Every routine appends contacts with the conventions of contact.h (normal
+// from B to A) and never divides by zero: coincident centres get a fixed normal. `speculative` (m, >= 0): shapes up to
+// that far apart get a contact too, with a negative penetration (the gap). The solver lets such a contact close at most
+// its gap per step (speculative contacts, Box2D v3), so a body that would pass through within a tick stops at the
 // surface instead; the world sets it from the bodies' speeds (sim/collision/world_contacts.cpp).
 #pragma once
 
 #include <vector>
 
 #include "sim/collision/contact.h"
-#include "sim/terrain/terrain.h"
+#include "sim/math/scalar_ops.h"
 
 namespace sg {
 
@@ -24,18 +23,5 @@ int collideSphereSphere(int32_t a, const Vec3<S>& ca, S ra, int32_t b, const Vec
 template <class S>
 int collideSphereBox(int32_t a, const Vec3<S>& ca, S ra, int32_t b, const Vec3<S>& hb, const Pose<S>& pb,
                      std::vector<Contact<S>>& out, S speculative = S(0));
-
-/// Sphere A against the terrain: the terrain plane under the centre (height and normal there).
-template <class S>
-int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& terrain, std::vector<Contact<S>>& out,
-                         S speculative = S(0));
-
-/// Box A against the terrain. The thesis tested the eight corners against the height under them;
-/// that lets a box sink through a ridge between its corners, so heightmap samples under the box
-/// footprint that lie inside the box are contacts too (pushed out through the nearest face).
-/// Corners up to `speculative` above the terrain are speculative contacts; samples only overlap.
-template <class S>
-int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Terrain<S>& terrain,
-                      std::vector<Contact<S>>& out, S speculative = S(0));
 
 }  // namespace sg

@@ -63,9 +63,12 @@ template <class S>
 S Terrain<S>::heightAt(S x, S z) const {
   if (flat_) return flatHeight_;
   const Cell c = cellAt(x, z);
-  const S h0 = lerp(sample(c.ix, c.iz), sample(c.ix + 1, c.iz), c.tx);
-  const S h1 = lerp(sample(c.ix, c.iz + 1), sample(c.ix + 1, c.iz + 1), c.tx);
-  return lerp(h0, h1, c.tz);
+  const S h00 = sample(c.ix, c.iz), h10 = sample(c.ix + 1, c.iz);
+  const S h01 = sample(c.ix, c.iz + 1), h11 = sample(c.ix + 1, c.iz + 1);
+  // The lower triangle (00, 01, 10) from sample 00, the upper (10, 01, 11) from sample 11: on
+  // the diagonal both give the same height (it lies on the edge 10-01 of both).
+  if (c.tx + c.tz < S(1)) return h00 + (h10 - h00) * c.tx + (h01 - h00) * c.tz;
+  return h11 + (h01 - h11) * (S(1) - c.tx) + (h10 - h11) * (S(1) - c.tz);
 }
 
 template <class S>
@@ -79,30 +82,18 @@ void Terrain<S>::normalAt(S x, S z, S* nx, S* ny, S* nz) const {
   const Cell c = cellAt(x, z);
   const S h00 = sample(c.ix, c.iz), h10 = sample(c.ix + 1, c.iz);
   const S h01 = sample(c.ix, c.iz + 1), h11 = sample(c.ix + 1, c.iz + 1);
+  // Lower iff tx + tz < 1, as heightAt. Beyond the high edge t = 1, so the upper triangle: its
+  // slope along that edge is the edge's own (the lower one's would be the previous column's).
+  const bool lower = c.tx + c.tz < S(1);
   // Beyond the map along an axis the edge samples extend, so the height does not change along
   // it: that slope is 0 (the edge cell's slope there tilted the normal of flat ground, and a body
   // resting beyond the edge slid away).
-  const S dhdx = c.outsideX ? S(0) : lerp(h10 - h00, h11 - h01, c.tz) * invCellSize_;
-  const S dhdz = c.outsideZ ? S(0) : lerp(h01 - h00, h11 - h10, c.tx) * invCellSize_;
+  const S dhdx = c.outsideX ? S(0) : (lower ? h10 - h00 : h11 - h01) * invCellSize_;
+  const S dhdz = c.outsideZ ? S(0) : (lower ? h01 - h00 : h11 - h10) * invCellSize_;
   const S len = length3(dhdx, S(1), dhdz);
   *nx = -dhdx / len;
   *ny = S(1) / len;
   *nz = -dhdz / len;
-}
-
-template <class S>
-void Terrain<S>::samplesInside(S x, S z, S radius, std::vector<std::pair<S, S>>& out) const {
-  out.clear();
-  if (flat_) return;
-  const int64_t x0 = std::max<int64_t>(0, floorToInt((std::clamp(x - radius, loX_, hiX_) - originX_) * invCellSize_));
-  const int64_t x1 =
-      std::min<int64_t>(width_ - 1, floorToInt((std::clamp(x + radius, loX_, hiX_) - originX_) * invCellSize_) + 1);
-  const int64_t z0 = std::max<int64_t>(0, floorToInt((std::clamp(z - radius, loZ_, hiZ_) - originZ_) * invCellSize_));
-  const int64_t z1 =
-      std::min<int64_t>(depth_ - 1, floorToInt((std::clamp(z + radius, loZ_, hiZ_) - originZ_) * invCellSize_) + 1);
-  for (int64_t iz = z0; iz <= z1; ++iz)
-    for (int64_t ix = x0; ix <= x1; ++ix)
-      out.emplace_back(originX_ + mulInt(cellSize_, ix), originZ_ + mulInt(cellSize_, iz));
 }
 
 template class Terrain<Fx32>;

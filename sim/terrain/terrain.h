@@ -1,10 +1,14 @@
-// Ground height and normal: flat, or bilinear over an 8-bit heightmap. Deterministic in every
-// scalar: positions map to cells by multiplying with the precomputed 1/cellSize, heights are the
-// exact rounding of maxHeight * sample / 255. Outside the heightmap the edge samples extend.
+// Ground height and normal: flat, or triangles over an 8-bit heightmap. Each cell between four
+// samples is split along its anti-diagonal, from sample (ix + 1, iz) to (ix, iz + 1) (the
+// diagonal the viewer's ground mesh uses), so the ground is piecewise planar: a heightmap whose
+// samples lie on a plane is that plane exactly, and every point has one face normal (no interior
+// ghost normals; a bilinear patch is curved inside each cell). Deterministic in every scalar:
+// positions map to cells by multiplying with the precomputed 1/cellSize, heights are the exact
+// rounding of maxHeight * sample / 255. Outside the heightmap the edge samples extend.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
-#include <utility>
 #include <vector>
 
 #include "sim/math/scalar_ops.h"
@@ -21,16 +25,39 @@ class Terrain {
   bool flat() const { return flat_; }
   /// Height (m) at world (x, z).
   S heightAt(S x, S z) const;
-  /// Unit normal at world (x, z): the normalised (-dh/dx, 1, -dh/dz) of the bilinear patch.
+  /// Unit normal at world (x, z): the normalised (-dh/dx, 1, -dh/dz) of the triangle there.
   void normalAt(S x, S z, S* nx, S* ny, S* nz) const;
-  /// World (x, z) of the heightmap samples within `radius` of (x, z) on both axes, row by row
-  /// (none for a flat terrain).
-  void samplesInside(S x, S z, S radius, std::vector<std::pair<S, S>>& out) const;
+
+  // Sample-index access for the narrow phase (sim/collision/terrain_contacts.cpp). Indices may
+  // lie beyond the map: there the nearest edge sample's height extends, so the grid of vertices
+  // (ix, iz) -> (sampleX(ix), heightOfSample(ix, iz), sampleZ(iz)) describes the whole ground.
+  S cellSize() const { return cellSize_; }
+  S invCellSize() const { return invCellSize_; }
+  S sampleX(int64_t ix) const { return originX_ + mulInt(cellSize_, ix); }
+  S sampleZ(int64_t iz) const { return originZ_ + mulInt(cellSize_, iz); }
+  S heightOfSample(int64_t ix, int64_t iz) const {
+    return sample(std::clamp<int64_t>(ix, 0, width_ - 1), std::clamp<int64_t>(iz, 0, depth_ - 1));
+  }
+  /// The cell column holding world x, for x within [lowX(), highX()] (the map and two cells around).
+  int64_t cellX(S x) const { return floorToInt((x - originX_) * invCellSize_); }
+  int64_t cellZ(S z) const { return floorToInt((z - originZ_) * invCellSize_); }
+  /// The triangle holding world (x, z), by the rule heightAt uses (no clamping: for points within
+  /// a few cells of [lowX(), highX()] x [lowZ(), highZ()]).
+  void triangleAt(S x, S z, int64_t* ix, int64_t* iz, bool* lower) const {
+    const S fx = (x - originX_) * invCellSize_, fz = (z - originZ_) * invCellSize_;
+    *ix = floorToInt(fx);
+    *iz = floorToInt(fz);
+    *lower = fractionalPart(fx) + fractionalPart(fz) < S(1);
+  }
+  S lowX() const { return loX_; }
+  S highX() const { return hiX_; }
+  S lowZ() const { return loZ_; }
+  S highZ() const { return hiZ_; }
 
  private:
   struct Cell {
     int64_t ix, iz;                           // lower sample indices
-    S tx, tz;                                 // in [0, 1]
+    S tx, tz;                                 // in [0, 1]; tx + tz <= 1: the lower triangle
     bool outsideX = false, outsideZ = false;  // beyond the map along that axis: the height is constant along it
   };
   Cell cellAt(S x, S z) const;

@@ -396,6 +396,7 @@ struct Renderer::Impl {
         }
       for (size_t j = 0; j + 1 < nz; ++j)
         for (size_t i = 0; i + 1 < nx; ++i) {
+          // Split along b-c, from (i + 1, j) to (i, j + 1): the simulation's ground triangles.
           const uint32_t a = uint32_t(j * nx + i), b = a + 1, c = uint32_t(a + nx), d = c + 1;
           idx.insert(idx.end(), {a, c, b, b, c, d});
         }

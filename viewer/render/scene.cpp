@@ -117,8 +117,19 @@ void extractGround(const World<S>& w, const Scenario& scenario, GroundGrid* g) {
   const double margin = std::max(20.0, 0.5 * std::max(x1 - x0, z1 - z0));
   const double step = scenario.terrain.flat ? 1.0 : std::max(0.05, scenario.terrain.cellSize.toDouble());
   constexpr double kSkirt = 3000.0;
-  g->xs = gridLines(x0 - margin, x1 + margin, step, 512);
-  g->zs = gridLines(z0 - margin, z1 + margin, step, 512);
+  double gx0 = x0 - margin, gx1 = x1 + margin, gz0 = z0 - margin, gz1 = z1 + margin;
+  if (!scenario.terrain.flat) {
+    // On the heightmap's own samples, so the mesh's triangles (split from (i + 1, j) to
+    // (i, j + 1), see uploadGround) are the simulation's ground triangles exactly, where the
+    // 512-cell cap and the 5 cm floor leave the resolution whole.
+    const double sx = toD(w.terrain().sampleX(0)), sz = toD(w.terrain().sampleZ(0));
+    gx0 = sx + step * std::floor((gx0 - sx) / step);
+    gx1 = sx + step * std::ceil((gx1 - sx) / step);
+    gz0 = sz + step * std::floor((gz0 - sz) / step);
+    gz1 = sz + step * std::ceil((gz1 - sz) / step);
+  }
+  g->xs = gridLines(gx0, gx1, step, 512);
+  g->zs = gridLines(gz0, gz1, step, 512);
   g->xs.insert(g->xs.begin(), float(x0 - kSkirt));
   g->xs.push_back(float(x1 + kSkirt));
   g->zs.insert(g->zs.begin(), float(z0 - kSkirt));

@@ -1,0 +1,268 @@
+#include "sim/collision/terrain_contacts.h"
+
+#include <algorithm>
+
+namespace sg {
+namespace {
+
+/// m: how far a neighbour may lie above a contact plane through a vertex or edge of the ground
+/// for that feature still to count as the ground's extreme point there. Rounding puts the
+/// neighbours of planar ground a few units off the plane; a ridge 1/4096 m high over a cell is
+/// flat for any body (and its faces still hold the body).
+template <class S>
+S convexMargin() {
+  return S(1) / S(4096);
+}
+
+/// A vertex of the ground grid in world coordinates (any indices: beyond the map the edge
+/// samples extend).
+template <class S>
+Vec3<S> vertexAt(const Terrain<S>& t, int64_t ix, int64_t iz) {
+  return Vec3<S>(t.sampleX(ix), t.heightOfSample(ix, iz), t.sampleZ(iz));
+}
+
+/// The six neighbours of a vertex in the triangulation (cells split from (ix+1, iz) to (ix, iz+1)).
+constexpr int kNeighbours[6][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, -1}, {-1, 1}};
+
+/// Whether no neighbour of vertex (ix, iz) lies more than the margin above the plane through p
+/// with normal n: the vertex is the ground's extreme point towards n (a peak, or a point of a
+/// ridge line, or planar ground touched straight along its normal).
+template <class S>
+bool vertexIsExtreme(const Terrain<S>& t, int64_t ix, int64_t iz, const Vec3<S>& p, const Vec3<S>& n) {
+  for (const auto& o : kNeighbours)
+    if ((vertexAt(t, ix + o[0], iz + o[1]) - p).dot(n) > convexMargin<S>()) return false;
+  return true;
+}
+
+/// Whether the six triangles around vertex (ix, iz) lie in one plane (to the margin): the height
+/// steps to opposite neighbours agree. Such a vertex is no feature at all; its faces' contacts
+/// (a box's corners, a sphere's face foot) carry the body. A box nearly flat on planar ground
+/// otherwise took every sample under it as a contact along the box's own face normal, tilted
+/// with the box's rocking: sideways pushes that turned a sliding box 5 cm off its line.
+template <class S>
+bool vertexIsPlanar(const Terrain<S>& t, int64_t ix, int64_t iz) {
+  const S h = t.heightOfSample(ix, iz), margin = convexMargin<S>();
+  const S stepX = t.heightOfSample(ix + 1, iz) - h, stepZ = t.heightOfSample(ix, iz + 1) - h;
+  return abs(S(h - t.heightOfSample(ix - 1, iz) - stepX)) <= margin &&
+         abs(S(h - t.heightOfSample(ix, iz - 1) - stepZ)) <= margin &&
+         abs(S(t.heightOfSample(ix + 1, iz - 1) - h - stepX + stepZ)) <= margin &&
+         abs(S(t.heightOfSample(ix - 1, iz + 1) - h + stepX - stepZ)) <= margin;
+}
+
+/// Feature keys for warm starting (contact.h): the kind in 3 bits, the cell's indices (mod 2^14)
+/// above it. Unique within any body's reach.
+enum TerrainFeature : uint32_t { kLowerFace, kUpperFace, kEdgeAlongX, kEdgeAlongZ, kDiagonalEdge, kVertex };
+uint32_t featureKey(TerrainFeature kind, int64_t ix, int64_t iz) {
+  return uint32_t(kind) | (uint32_t(uint64_t(ix)) & 0x3fffu) << 3 | (uint32_t(uint64_t(iz)) & 0x3fffu) << 17;
+}
+
+/// The unit normal of a ground triangle from its slopes dh/dx, dh/dz (as Terrain::normalAt).
+template <class S>
+Vec3<S> faceNormal(S dhdx, S dhdz) {
+  const S len = length3(dhdx, S(1), dhdz);
+  return Vec3<S>(-dhdx / len, S(1) / len, -dhdz / len);
+}
+
+/// One contact of a sphere (centre ca, radius ra) along `normal` at `dist` from the ground.
+template <class S>
+void addSphereContact(int32_t a, const Vec3<S>& ca, S ra, uint32_t feature, const Vec3<S>& normal, S dist,
+                      std::vector<Contact<S>>& out) {
+  Contact<S> c;
+  c.bodyA = a;
+  c.bodyB = kTerrainBody;
+  c.featureB = feature;
+  c.normal = normal;
+  c.penetration = ra - dist;
+  c.point = ca - normal * minS(dist, ra);  // speculative: the sphere's lowest point, not the ground far below
+  out.push_back(c);
+}
+
+/// The plane under the centre (flat ground, or a centre below a heightmap's ground).
+template <class S>
+int spherePlaneUnderCentre(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& terrain, std::vector<Contact<S>>& out,
+                           S speculative) {
+  const S h = terrain.heightAt(ca.x(), ca.z());
+  if (ca.y() - h >= ra + ra + speculative) return 0;  // far above: not even a steep slope can touch
+  Vec3<S> n;
+  terrain.normalAt(ca.x(), ca.z(), &n.x(), &n.y(), &n.z());
+  const S dist = (ca.y() - h) * n.y();  // to the plane through (x, h, z)
+  if (dist >= ra + speculative) return 0;
+  addSphereContact(a, ca, ra, 0, n, dist, out);  // the only contact then: feature 0
+  return 1;
+}
+
+/// Edge a-b of the ground against centre c: the closest point strictly inside the edge (its ends
+/// are the vertices' business), within `reach`, where the third corners f1, f2 of the edge's two
+/// triangles lie below the plane through that point normal to c - p by more than the margin (a
+/// convex crease; planar or concave ground leaves the contact to its faces).
+template <class S>
+bool edgeContact(const Terrain<S>& t, const Vec3<S>& c, S reach, const Vec3<S>& a, const Vec3<S>& b, int64_t f1x,
+                 int64_t f1z, int64_t f2x, int64_t f2z, Vec3<S>* normal, S* dist) {
+  const Vec3<S> ab = b - a;
+  const S along = (c - a).dot(ab), length2 = ab.dot(ab);
+  if (!(along > S(0)) || !(along < length2)) return false;
+  const Vec3<S> p = a + ab * (along / length2);
+  const Vec3<S> d = c - p;
+  if (abs(d.x()) >= reach || abs(d.y()) >= reach || abs(d.z()) >= reach) return false;
+  *dist = length3(d.x(), d.y(), d.z());
+  if (!(*dist < reach) || *dist == S(0)) return false;
+  *normal = d / *dist;
+  return (vertexAt(t, f1x, f1z) - p).dot(*normal) < -convexMargin<S>() &&
+         (vertexAt(t, f2x, f2z) - p).dot(*normal) < -convexMargin<S>();
+}
+
+/// Face (v, slopes) of cell (ix, iz): the centre's foot on its plane when that foot lies in the
+/// triangle itself (by heightAt's rule, so a foot on a shared edge belongs to one face only).
+template <class S>
+bool faceContact(const Terrain<S>& t, const Vec3<S>& c, S reach, const Vec3<S>& v, S dhdx, S dhdz, int64_t ix,
+                 int64_t iz, bool lower, Vec3<S>* normal, S* dist) {
+  *normal = faceNormal(dhdx, dhdz);
+  *dist = (c - v).dot(*normal);
+  if (!(*dist < reach)) return false;
+  const Vec3<S> foot = c - *normal * *dist;
+  int64_t fx = 0, fz = 0;
+  bool fLower = false;
+  t.triangleAt(foot.x(), foot.z(), &fx, &fz, &fLower);
+  return fx == ix && fz == iz && fLower == lower;
+}
+
+/// Most cells a sphere's reach may span along an axis before it takes the plane under its centre
+/// instead (a fast or huge sphere over fine cells: the cost is the square of this).
+constexpr int64_t kMaxReachCells = 64;
+
+}  // namespace
+
+template <class S>
+int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& terrain, std::vector<Contact<S>>& out,
+                         S speculative) {
+  if (terrain.flat() || ca.y() < terrain.heightAt(ca.x(), ca.z()))
+    return spherePlaneUnderCentre(a, ca, ra, terrain, out, speculative);
+  const S reach = ra + speculative;
+  // Beyond the map and its two-cell margin the ground does not change along that axis: the
+  // centre moves in to where its reach just meets the margin, which changes no distance and keeps
+  // the cell range short and the indices in range (contact points are moved back).
+  Vec3<S> c = ca;
+  c.x() = std::clamp(c.x(), S(terrain.lowX() - reach), S(terrain.highX() + reach));
+  c.z() = std::clamp(c.z(), S(terrain.lowZ() - reach), S(terrain.highZ() + reach));
+  const int64_t i0 = terrain.cellX(c.x() - reach), i1 = terrain.cellX(c.x() + reach);
+  const int64_t j0 = terrain.cellZ(c.z() - reach), j1 = terrain.cellZ(c.z() + reach);
+  if (i1 - i0 > kMaxReachCells || j1 - j0 > kMaxReachCells)
+    return spherePlaneUnderCentre(a, ca, ra, terrain, out, speculative);
+  S top = terrain.heightOfSample(i0, j0);
+  for (int64_t j = j0; j <= j1 + 1; ++j)
+    for (int64_t i = i0; i <= i1 + 1; ++i) top = maxS(top, terrain.heightOfSample(i, j));
+  if (c.y() - top >= reach) return 0;  // above every vertex, so above every face, by the reach
+
+  const S inv = terrain.invCellSize();
+  const size_t first = out.size();
+  Vec3<S> n;
+  S dist;
+  for (int64_t j = j0; j <= j1 + 1; ++j)
+    for (int64_t i = i0; i <= i1 + 1; ++i) {
+      const Vec3<S> v00 = vertexAt(terrain, i, j), v10 = vertexAt(terrain, i + 1, j);
+      const Vec3<S> v01 = vertexAt(terrain, i, j + 1);
+      if (i <= i1 && j <= j1) {  // the cell's two faces and its diagonal
+        const Vec3<S> v11 = vertexAt(terrain, i + 1, j + 1);
+        if (faceContact(terrain, c, reach, v00, S((v10.y() - v00.y()) * inv), S((v01.y() - v00.y()) * inv), i, j, true,
+                        &n, &dist))
+          addSphereContact(a, ca, ra, featureKey(kLowerFace, i, j), n, dist, out);
+        if (faceContact(terrain, c, reach, v11, S((v11.y() - v01.y()) * inv), S((v11.y() - v10.y()) * inv), i, j, false,
+                        &n, &dist))
+          addSphereContact(a, ca, ra, featureKey(kUpperFace, i, j), n, dist, out);
+        if (edgeContact(terrain, c, reach, v10, v01, i, j, i + 1, j + 1, &n, &dist))
+          addSphereContact(a, ca, ra, featureKey(kDiagonalEdge, i, j), n, dist, out);
+      }
+      // The edges from this vertex along +x and +z, with the third corners of their triangles.
+      if (edgeContact(terrain, c, reach, v00, v10, i, j + 1, i + 1, j - 1, &n, &dist))
+        addSphereContact(a, ca, ra, featureKey(kEdgeAlongX, i, j), n, dist, out);
+      if (edgeContact(terrain, c, reach, v00, v01, i + 1, j, i - 1, j + 1, &n, &dist))
+        addSphereContact(a, ca, ra, featureKey(kEdgeAlongZ, i, j), n, dist, out);
+      const Vec3<S> d = c - v00;
+      if (abs(d.x()) >= reach || abs(d.y()) >= reach || abs(d.z()) >= reach) continue;
+      dist = length3(d.x(), d.y(), d.z());
+      if (!(dist < reach) || dist == S(0)) continue;
+      n = d / dist;
+      if (!vertexIsPlanar(terrain, i, j) && vertexIsExtreme(terrain, i, j, v00, n))
+        addSphereContact(a, ca, ra, featureKey(kVertex, i, j), n, dist, out);
+    }
+  return int(out.size() - first);
+}
+
+template <class S>
+int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Terrain<S>& terrain,
+                      std::vector<Contact<S>>& out, S speculative) {
+  int added = 0;
+  // 1. Corners against the triangle under each (exact distance to its plane).
+  for (uint32_t corner = 0; corner < 8; ++corner) {
+    const Vec3<S> local((corner & 1) ? ha.x() : -ha.x(), (corner & 2) ? ha.y() : -ha.y(),
+                        (corner & 4) ? ha.z() : -ha.z());
+    const Vec3<S> p = pa.toWorld(local);
+    const S h = terrain.heightAt(p.x(), p.z());
+    if (p.y() - h >= speculative) continue;  // the vertical gap bounds the gap along the normal
+    Vec3<S> n;
+    terrain.normalAt(p.x(), p.z(), &n.x(), &n.y(), &n.z());
+    Contact<S> c;
+    c.bodyA = a;
+    c.bodyB = kTerrainBody;
+    c.featureA = corner;
+    c.normal = n;
+    c.penetration = (h - p.y()) * n.y();
+    c.point = p;
+    out.push_back(c);
+    ++added;
+  }
+  if (terrain.flat()) return added;
+  // 2. Heightmap vertices inside the box, each pushed out through the shallowest face towards
+  // which it is the ground's extreme point. On planar ground that is only the face lying on the
+  // ground (no side face: a side face pointing up a slope was the ghost that stopped boxes
+  // sliding over fine heightmaps); none at all when the box is not flat on it.
+  const S radius = ha.norm();
+  const Vec3<S>& centre = pa.position;
+  const int64_t i0 = terrain.cellX(std::clamp(S(centre.x() - radius), terrain.lowX(), terrain.highX()));
+  const int64_t i1 = terrain.cellX(std::clamp(S(centre.x() + radius), terrain.lowX(), terrain.highX())) + 1;
+  const int64_t j0 = terrain.cellZ(std::clamp(S(centre.z() - radius), terrain.lowZ(), terrain.highZ()));
+  const int64_t j1 = terrain.cellZ(std::clamp(S(centre.z() + radius), terrain.lowZ(), terrain.highZ())) + 1;
+  for (int64_t j = j0; j <= j1; ++j)
+    for (int64_t i = i0; i <= i1; ++i) {
+      const Vec3<S> v = vertexAt(terrain, i, j);
+      const Vec3<S> local = pa.toLocal(v);
+      if (abs(local.x()) >= ha.x() || abs(local.y()) >= ha.y() || abs(local.z()) >= ha.z()) continue;
+      if (vertexIsPlanar(terrain, i, j)) continue;
+      int bestFace = -1;
+      S bestDepth{};
+      Vec3<S> bestNormal = Vec3<S>::UnitY();
+      for (int face = 0; face < 6; ++face) {
+        const int axis = face / 2;
+        const S side = face % 2 == 0 ? S(1) : S(-1);
+        const S depth = ha[axis] - side * local[axis];  // below that face (m)
+        if (bestFace >= 0 && !(depth < bestDepth)) continue;
+        Vec3<S> outward = Vec3<S>::Zero();
+        outward[axis] = side;
+        const Vec3<S> n = -(pa.rotation * outward);  // the ground pushes the box away from that face
+        if (!vertexIsExtreme(terrain, i, j, v, n)) continue;
+        bestFace = face;
+        bestDepth = depth;
+        bestNormal = n;
+      }
+      if (bestFace < 0) continue;
+      Contact<S> c;
+      c.bodyA = a;
+      c.bodyB = kTerrainBody;
+      c.featureA = 8 + uint32_t(bestFace);
+      c.featureB = featureKey(kVertex, i, j);
+      c.normal = bestNormal;
+      c.penetration = bestDepth;
+      c.point = v;
+      out.push_back(c);
+      ++added;
+    }
+  return added;
+}
+
+#define SG_INSTANTIATE(S)                                                                                              \
+  template int collideSphereTerrain(int32_t, const Vec3<S>&, S, const Terrain<S>&, std::vector<Contact<S>>&, S);       \
+  template int collideBoxTerrain(int32_t, const Vec3<S>&, const Pose<S>&, const Terrain<S>&, std::vector<Contact<S>>&, \
+                                 S);
+SG_FOR_EACH_SCALAR(SG_INSTANTIATE)
+#undef SG_INSTANTIATE
+}  // namespace sg
