@@ -17,6 +17,24 @@ inline void applyGravity(std::vector<RigidBody<S>>& bodies, const Vec3<S>& gravi
     if (!b.asleep) b.velocity += gravityH;
 }
 
+/// |w| capped at maxAngularSpeed (rad/s), about the same axis. Box2D v3 caps a body's rotation
+/// at a quarter turn per sub-step (b2_maxRotation) and Jolt at mMaxAngularVelocity: past it the
+/// position step's small-angle quaternion update is wrong anyway, and w^2 I (the gyroscopic
+/// term, a contact's r x w) left fx16's range: a 10 kg box hit at 200 m/s on a spiky heightmap
+/// spun past 1,000 rad/s and overflowed. Every scalar caps alike, so variants stay comparable.
+template <class S>
+inline void clampAngularSpeed(std::vector<RigidBody<S>>& bodies, S maxAngularSpeed) {
+  for (RigidBody<S>& b : bodies) {
+    if (b.asleep) continue;
+    const Vec3<S>& w = b.angularVelocity;
+    if (!(abs(w.x()) > maxAngularSpeed / S(2)) && !(abs(w.y()) > maxAngularSpeed / S(2)) &&
+        !(abs(w.z()) > maxAngularSpeed / S(2)))
+      continue;  // |w| <= sqrt(3)/2 of the cap: the common case without a square root
+    const S speed = length3(w.x(), w.y(), w.z());
+    if (speed > maxAngularSpeed) b.angularVelocity *= maxAngularSpeed / speed;
+  }
+}
+
 /// p += v h; q += h/2 (0, w) q, renormalised (h: one sub-step, s).
 template <class S>
 inline void integrateBodyPositions(std::vector<RigidBody<S>>& bodies, S h) {

@@ -376,13 +376,15 @@ void storeImpulses(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<
       deep[size_t(row.a)] = 1;
       if (row.b != kTerrainBody) deep[size_t(row.b)] = 1;
     }
+    // In velocity units (impulse / mass): the sums of a heavy body's many deep contacts in
+    // N s overflowed fx16; each body's sums share its mass, so the comparison is the same.
     const Vec3<S> force = row.t1.dir * row.t1.impulse + row.t2.dir * row.t2.impulse;  // on A; -force on B
     const S most = row.friction * row.normal.impulse;
-    friction[size_t(row.a)] += force;
-    limit[size_t(row.a)] += most;
+    friction[size_t(row.a)] += force * row.invMassA;
+    limit[size_t(row.a)] += most * row.invMassA;
     if (row.b != kTerrainBody) {
-      friction[size_t(row.b)] -= force;
-      limit[size_t(row.b)] += most;
+      friction[size_t(row.b)] -= force * row.invMassB;
+      limit[size_t(row.b)] += most * row.invMassB;
     }
   }
   for (size_t i = 0; i < bodies.size(); ++i) {

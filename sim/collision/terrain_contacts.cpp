@@ -73,7 +73,10 @@ void addSphereContact(int32_t a, const Vec3<S>& ca, S ra, uint32_t feature, cons
   c.featureB = feature;
   c.normal = normal;
   c.penetration = ra - dist;
-  c.point = ca - normal * minS(dist, ra);  // speculative: the sphere's lowest point, not the ground far below
+  // Speculative: the sphere's lowest point, not the ground far below; deep (the centre under the
+  // ground): no farther than r from the centre either, not the ground far above. A longer arm is
+  // a larger angular term (a small ball 13 m under a hill overflowed fx16's r x n . I^-1 (r x n)).
+  c.point = ca - normal * maxS(minS(dist, ra), S(-ra));
   out.push_back(c);
 }
 

@@ -81,6 +81,7 @@ bool World<S>::respondToContacts() {
   prepareContacts(bodies_, contacts_, impulseCache_, contactRows_);  // before gravity: the approach velocities
   for (int sub = 0; sub < solver_.substeps; ++sub) {
     applyGravity(bodies_, gravitySubstep_);
+    clampAngularSpeed(bodies_, maxAngularSpeed_);
     applyGyroscopicTerm(bodies_, substepDt_);
     warmStartContacts(bodies_, contactRows_);
     for (int it = 0; it < solver_.solveIterations; ++it) solveContacts(bodies_, contactRows_, solver_, true);

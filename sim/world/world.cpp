@@ -143,6 +143,10 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
     solver_.bodySoftness = makeSoftness(hertz, zeta, substepDt_, pi);
     solver_.staticSoftness = makeSoftness(S(2) * hertz, zeta, substepDt_, pi);
   }
+  // A quarter turn per sub-step (Box2D v3's b2_maxRotation): (pi / 4) x substeps / dt, exact
+  // before the one rounding (188 rad/s at the defaults).
+  maxAngularSpeed_ =
+      toS<S>(*mul(*mul(exact(settings::kPi), Rational{1, 4}), *div(Rational{s.bodies.substeps, 1}, s.timeStep)));
   speculativeDistance_ = toS<S>(exact(settings::kSpeculativeDistance));
   bodyBroadphase_ = s.bodies.bodyBroadphase;
   grassDragDt_ = toS<S>(s.bodies.grassDrag) * particleConsts_.dt;

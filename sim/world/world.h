@@ -157,6 +157,7 @@ class World final : public SimWorld {
   Vec3<S> gravityDt_ = Vec3<S>::Zero();       ///< g dt (m/s): a body's speed gain in one tick
   Vec3<S> gravitySubstep_ = Vec3<S>::Zero();  ///< g h (m/s) for one sub-step
   S substepDt_{};                             ///< h = dt / substeps (s)
+  S maxAngularSpeed_{};                       ///< rad/s: a quarter turn per sub-step
   S speculativeDistance_{};                   ///< m (settings::kSpeculativeDistance)
   S sleepLinear_{}, sleepAngular_{};
   S grassDragDt_{};  ///< grassDrag * dt (N s/m * s = kg per tuft)
