@@ -43,12 +43,16 @@ std::vector<std::pair<int32_t, int32_t>> bodyPairs(const std::vector<RigidBody<S
   // Sweep and prune along x: order by interval start (id breaks ties), scan forward while the
   // next interval starts before this one ends.
   std::vector<int32_t> order(static_cast<size_t>(n));
-  for (int32_t i = 0; i < n; ++i) order[size_t(i)] = i;
-  auto lo = [&](int32_t i) { return bodies[size_t(i)].position.x() - bodies[size_t(i)].boundingRadius - grown(i); };
-  auto hi = [&](int32_t i) { return bodies[size_t(i)].position.x() + bodies[size_t(i)].boundingRadius + grown(i); };
-  std::stable_sort(order.begin(), order.end(), [&](int32_t a, int32_t b) { return lo(a) < lo(b); });
+  std::vector<S> lo(static_cast<size_t>(n)), hi(static_cast<size_t>(n));  // each body's x interval, formed once
+  for (int32_t i = 0; i < n; ++i) {
+    order[size_t(i)] = i;
+    const RigidBody<S>& b = bodies[size_t(i)];
+    lo[size_t(i)] = b.position.x() - b.boundingRadius - grown(i);
+    hi[size_t(i)] = b.position.x() + b.boundingRadius + grown(i);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](int32_t a, int32_t b) { return lo[size_t(a)] < lo[size_t(b)]; });
   for (size_t x = 0; x < order.size(); ++x)
-    for (size_t y = x + 1; y < order.size() && !(lo(order[y]) > hi(order[x])); ++y) {
+    for (size_t y = x + 1; y < order.size() && !(lo[size_t(order[y])] > hi[size_t(order[x])]); ++y) {
       const int32_t i = std::min(order[x], order[y]), j = std::max(order[x], order[y]);
       if (overlap(i, j)) pairs.emplace_back(i, j);
     }

@@ -33,7 +33,11 @@ void World<S>::detectContacts() {
   // touches a sleeping one wakes it and what rests with it (pairs in (i, j) order: the same
   // wake-ups for any broad phase). A wake-up can make pairs seen earlier in the pass active, so
   // the pass runs again until nothing more wakes (each rerun wakes at least one island).
-  const auto pairs = bodyPairs(bodies_, bodyBroadphase_, grown);
+  // With every body asleep no pair can make a contact or wake anything (commands wake bodies
+  // before this stage): the broad phase is skipped, as Box2D skips sleeping islands.
+  bool anyAwake = false;
+  for (const RigidBody<S>& b : bodies_) anyAwake = anyAwake || !b.asleep;
+  const auto pairs = anyAwake ? bodyPairs(bodies_, bodyBroadphase_, grown) : std::vector<std::pair<int32_t, int32_t>>{};
   for (bool woke = true; woke;) {
     woke = false;
     contacts_.clear();
