@@ -230,6 +230,10 @@ std::vector<RangeCase> huntCases() {
       {"MowerCutHeightFx16", field(R"(, "bodies": {"mowerCutHeight": 40000})"), "$.bodies.mowerCutHeight",
        ScalarKind::Fx16},
       {"GrassDragFx16", field(R"(, "bodies": {"grassDrag": 40000})"), "$.bodies.grassDrag", ScalarKind::Fx16},
+      {"ContactHertzFx16",
+       field(
+           R"(, "bodies": {"contactHertz": 40000, "list": [{"name": "b", "shape": {"type": "sphere", "radius": 0.5}}]})"),
+       "$.bodies.contactHertz", ScalarKind::Fx16},
       {"MarkingsLengthFx32", field(R"(, "markings": {"length": 1e20})"), "$.markings.length", ScalarKind::Fx32},
       {"MarkingsCenterFx16", field(R"(, "markings": {"center": [40000, 0]})"), "$.markings.center[0]",
        ScalarKind::Fx16},

@@ -236,6 +236,8 @@ INSTANTIATE_TEST_SUITE_P(ScenarioTypes, ScenarioParseError, testing::ValuesIn(kT
 const std::vector<BadCase> kValueCases = {
     // field
     {"SpacingZero", R"({"field": {"spacing": 0}})", "$.field.spacing", "positive"},
+    {"ContactHertzZero", R"({"bodies": {"contactHertz": 0}})", "$.bodies.contactHertz", "positive"},
+    {"ContactHertzNegative", R"({"bodies": {"contactHertz": -60}})", "$.bodies.contactHertz", "positive"},
     {"SpacingNegative", R"({"field": {"spacing": -0.25}})", "$.field.spacing", "positive"},
     {"SpacingNegativeFraction", R"({"field": {"spacing": "-1/4"}})", "$.field.spacing", "positive"},
     {"SpacingZeroFraction", R"({"field": {"spacing": "0/5"}})", "$.field.spacing", "positive"},

@@ -124,6 +124,26 @@ void expectTwentyBoxStackStands(const char* name) {
   EXPECT_TRUE(r.allAsleep) << name << ": a standing stack falls asleep as one island";
 }
 TEST(SoftStep, TwentyBoxStackStandsFx32) { expectTwentyBoxStackStands<Fx32>("fx32"); }
+
+// Without sleep the default contacts (60 Hz) let a 20-box column lean over in 10 to 20 s: each
+// contact's spring is set from its own box's mass while its load grows with the boxes above
+// (docs/physics-notes.md). Stiffer contacts carry it: 8 sub-steps (a 480 Hz sub-step rate allows
+// up to 120 Hz) and `contactHertz` 120 keep it standing for 20 s, awake the whole time.
+template <class S>
+void expectStiffContactsCarryATallStackAwake(const char* name) {
+  Scenario s = stackOf(20);
+  for (BodySpec& b : s.bodies.list) b.canSleep = false;
+  s.bodies.substeps = 8;
+  s.bodies.contactHertz = Rational{120, 1};
+  const Drift r = standFor<S>(s, 20.0);
+  std::printf("[stack of 20, no sleep, 8 sub-steps at 120 Hz, %s] horizontal %.4f m, sink %.4f m\n", name, r.horizontal,
+              r.sink);
+  EXPECT_LT(r.horizontal, 0.02) << name;  // as the sleeping stack; the default contacts drift 17 cm in 10 s
+  EXPECT_LT(r.sink, 20 * (0.001 + kSlop)) << name;
+  EXPECT_FALSE(r.allAsleep) << name;
+}
+TEST(SoftStep, StiffContactsCarryATallStackAwakeFx32) { expectStiffContactsCarryATallStackAwake<Fx32>("fx32"); }
+TEST(SoftStep, StiffContactsCarryATallStackAwakeDouble) { expectStiffContactsCarryATallStackAwake<double>("double"); }
 TEST(SoftStep, TwentyBoxStackStandsFx16) { expectTwentyBoxStackStands<Fx16>("fx16"); }
 TEST(SoftStep, TwentyBoxStackStandsDouble) { expectTwentyBoxStackStands<double>("double"); }
 

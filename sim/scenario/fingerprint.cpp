@@ -55,6 +55,12 @@ uint64_t scenarioFingerprint(const Scenario& s) {
                 int64_t(b.list.size())});
     for (const Rational& g : b.gravity) putRational(h, g);
     putRational(h, b.grassDrag);
+    // Only when set to another value, behind a tag: recordings made before the key existed (at
+    // the default) keep their fingerprint.
+    if (!(b.contactHertz == Rational{60, 1})) {
+      putInts(h, {0x636f6e7461637448});  // "contactH"
+      putRational(h, b.contactHertz);
+    }
     putRational(h, b.mowerCutHeight);
     for (const BodySpec& body : b.list) {
       h.put(uint64_t(body.name.size()));  // length first: names cannot run into what follows

@@ -164,6 +164,10 @@ struct Scenario {
     int substeps = 4;
     int velocityIterations = 3;  ///< solve sweeps per sub-step
     int positionIterations = 1;  ///< relax sweeps per sub-step (0: the push velocity stays)
+    /// Hz: the soft contacts' spring (Box2D's contactHertz), capped at a quarter of the sub-step
+    /// rate; the terrain's is twice it. The default is the cap at 60 Hz ticks and 4 sub-steps;
+    /// tall stacks without sleep need stiffer (docs/physics-notes.md).
+    Rational contactHertz{60, 1};
     ParticleBroadphase particleBroadphase = ParticleBroadphase::Grid;
     BodyBroadphase bodyBroadphase = BodyBroadphase::Brute;
     BoxParticleNormal boxParticleNormal = BoxParticleNormal::Up;

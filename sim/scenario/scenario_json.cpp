@@ -448,8 +448,9 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
 void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
   const std::string p = "$.bodies";
   r.object(j, p,
-           {"gravity", "substeps", "velocityIterations", "positionIterations", "particleBroadphase", "bodyBroadphase",
-            "boxParticleNormal", "mowerCutHeight", "grassDrag", "list"});
+           {"gravity", "substeps", "velocityIterations", "positionIterations", "contactHertz", "particleBroadphase",
+            "bodyBroadphase", "boxParticleNormal", "mowerCutHeight", "grassDrag", "list"});
+  if (j.contains("contactHertz")) b.contactHertz = r.positive(j["contactHertz"], p + ".contactHertz");
   if (j.contains("grassDrag")) b.grassDrag = r.nonNegative(j["grassDrag"], p + ".grassDrag");
   if (j.contains("mowerCutHeight")) b.mowerCutHeight = r.nonNegative(j["mowerCutHeight"], p + ".mowerCutHeight");
   if (j.contains("gravity")) b.gravity = r.vector<3>(j["gravity"], p + ".gravity");

@@ -351,6 +351,7 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
     // Everything else the world converts (world.cpp toS): no value may reach a throwing conversion.
     fits(s.bodies.mowerCutHeight, "$.bodies.mowerCutHeight");
     fits(s.bodies.grassDrag, "$.bodies.grassDrag");
+    fits(s.bodies.contactHertz, "$.bodies.contactHertz");
     fits(derived.invParticleSpacing, "$.field.spacing", "1/(spacing x interpolation)");
     fits(derived.dampingPerTick, "$.particles.damping", "damping per tick");
     if (s.markings.enabled) {

@@ -20,7 +20,7 @@ inline constexpr Exact kRestitutionThreshold{1, 1};
 /// spring that pushes overlap out, capped below a quarter of the sub-step rate (stiffer is not
 /// resolved by the sub-step), heavily overdamped so it does not bounce, and never faster than
 /// kContactPushMaxVelocity. Terrain contacts use twice the frequency (nothing there gives way).
-inline constexpr Exact kContactHertz{60, 1};
+/// The hertz is the scenario's `bodies.contactHertz` (default 60).
 inline constexpr Exact kContactDampingRatio{10, 1};
 inline constexpr Exact kContactPushMaxVelocity{3, 1};
 /// Shapes this close (m) get speculative contacts even when nothing moves (Box2D's

@@ -138,7 +138,7 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   {
     // Box2D: contact hertz at most a quarter of the sub-step rate; the terrain twice as stiff.
     const S quarterRate = solver_.invSubstep / S(4);
-    const S hertz = minS(toS<S>(exact(settings::kContactHertz)), quarterRate);
+    const S hertz = minS(toS<S>(s.bodies.contactHertz), quarterRate);
     const S zeta = toS<S>(exact(settings::kContactDampingRatio)), pi = toS<S>(exact(settings::kPi));
     solver_.bodySoftness = makeSoftness(hertz, zeta, substepDt_, pi);
     solver_.staticSoftness = makeSoftness(S(2) * hertz, zeta, substepDt_, pi);
