@@ -181,5 +181,61 @@ TEST(Gyroscopic, SpinAboutAStableAxisStays) {
   }
 }
 
+// The angular-speed cap (Box2D v3's b2_maxRotation): a quarter turn per sub-step, (pi / 4) x 4 x
+// 60 = 188.5 rad/s at the defaults (pi as 355/113), in every scalar. It applies before each
+// sub-step's gyroscopic term, which then keeps the rotational energy but not |w|: a capped body
+// has at most the energy of the cap about its largest axis, so |w| <= cap sqrt(I_max / I_min).
+template <class S>
+void expectAngularSpeedIsCapped(const char* name) {
+  Scenario s = spinningBox(Rational{1, 60});
+  s.bodies.list[0].angularVelocity = {Rational{600, 1}, Rational{800, 1}, Rational{0, 1}};  // 1,000 rad/s
+  auto w = makeTyped<S>(s);
+  ASSERT_TRUE(w->step(TickInput{}).ok) << name;
+  const auto& b = w->bodies()[0];
+  const double wx = ScalarTraits<S>::toDouble(b.angularVelocity.x()),
+               wy = ScalarTraits<S>::toDouble(b.angularVelocity.y());
+  const double wz = ScalarTraits<S>::toDouble(b.angularVelocity.z());
+  const double cap = 355.0 / 113.0 / 4 * 240, speed = std::sqrt(wx * wx + wy * wy + wz * wz);
+  const auto& I = b.inertiaLocal;
+  const Vec3<S> wb = b.rotation.transpose() * b.angularVelocity;
+  double energy = 0, largest = 0, smallest = 1e9;
+  for (int k = 0; k < 3; ++k) {
+    const double ik = ScalarTraits<S>::toDouble(I[k]), wk = ScalarTraits<S>::toDouble(wb[k]);
+    energy += ik * wk * wk;
+    largest = std::max(largest, ik);
+    smallest = std::min(smallest, ik);
+  }
+  EXPECT_LE(energy, largest * cap * cap * (1 + 1e-3)) << name;
+  EXPECT_LE(speed, cap * std::sqrt(largest / smallest) * (1 + 1e-3)) << name;
+  EXPECT_GT(speed, 0.9 * cap) << name;  // capped, not stopped
+}
+TEST(Gyroscopic, AngularSpeedIsCappedFx32) { expectAngularSpeedIsCapped<Fx32>("fx32"); }
+TEST(Gyroscopic, AngularSpeedIsCappedFx16) { expectAngularSpeedIsCapped<Fx16>("fx16"); }
+TEST(Gyroscopic, AngularSpeedIsCappedDouble) { expectAngularSpeedIsCapped<double>("double"); }
+
+// fx16: a large body (200 kg, 3 x 1 x 0.6 m: principal inertias up to 167 kg m^2) tumbling at
+// 18 rad/s. The gyroscopic term formed I w^2 (and its energy check I w^2 unscaled below
+// 128 rad/s): past fx16's range, a fixed-point overflow at the first sub-step. It now steps, and
+// keeps its energy within the midpoint rule's wander.
+TEST(Gyroscopic, LargeTumblingBodyStaysInFx16Range) {
+  Scenario s = spinningBox(Rational{1, 60});
+  s.bodies.list[0].mass = Rational{200, 1};
+  s.bodies.list[0].parts[0].halfExtents = {Rational{3, 2}, Rational{1, 2}, Rational{3, 10}};
+  s.bodies.list[0].angularVelocity = {Rational{1, 1}, Rational{18, 1}, Rational{1, 2}};
+  auto w = makeTyped<Fx16>(s);
+  for (int t = 0; t < 600; ++t) ASSERT_TRUE(w->step(TickInput{}).ok) << "tick " << t;
+  const auto& b = w->bodies()[0];
+  const Vec3<Fx16> wb = b.rotation.transpose() * b.angularVelocity;
+  const auto& I = b.inertiaLocal;
+  double energy = 0, start = 0;
+  const double w0[3] = {1, 18, 0.5};
+  for (int k = 0; k < 3; ++k) {
+    energy += I[k].toDouble() * wb[k].toDouble() * wb[k].toDouble();
+    start += I[k].toDouble() * w0[k] * w0[k];
+  }
+  EXPECT_LE(energy, start * (1 + 1e-3));
+  EXPECT_GT(energy, start * 0.98);
+}
+
 }  // namespace
 }  // namespace sg

@@ -6,11 +6,29 @@ namespace sg {
 namespace {
 
 /// m: how far a neighbour may lie above a contact plane through a vertex or edge of the ground
-/// for that feature still to count as the ground's extreme point there. Rounding puts the
-/// neighbours of planar ground a few units off the plane; a ridge 1/4096 m high over a cell is
-/// flat for any body (and its faces still hold the body).
+/// for that feature still to count as the ground's extreme point there: a lean of 1/1024 rad
+/// over a cell, plus rounding (16 units of a fixed-point format; float and double well above
+/// theirs at kilometre coordinates). A straight ridge line's own neighbours lie *on* such a plane
+/// and a box resting on it rocks by far less than a milliradian, so it must count; and a crease
+/// bent by less than a margin must still count, or the wedge above it between its faces' regions
+/// has no contact at all (a ball fell through a 0.2 mm ridge when edges had to be convex by
+/// 1/4096 m). Against ghosts it is tight: a side face or a rocking box is leaning by far more.
 template <class S>
-S convexMargin() {
+S convexMargin(const Terrain<S>& t) {
+  S rounding;
+  if constexpr (ScalarTraits<S>::isFixed) {
+    rounding = S::fromRaw(16);
+  } else if constexpr (sizeof(S) == sizeof(float)) {
+    rounding = S(1e-4f);
+  } else {
+    rounding = S(1e-9);
+  }
+  return rounding + t.cellSize() / S(1024);
+}
+
+/// m: a vertex whose six triangles agree in height steps to this is planar (no feature).
+template <class S>
+S planarMargin() {
   return S(1) / S(4096);
 }
 
@@ -29,8 +47,9 @@ constexpr int kNeighbours[6][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, -1}, {-
 /// ridge line, or planar ground touched straight along its normal).
 template <class S>
 bool vertexIsExtreme(const Terrain<S>& t, int64_t ix, int64_t iz, const Vec3<S>& p, const Vec3<S>& n) {
+  const S margin = convexMargin(t);
   for (const auto& o : kNeighbours)
-    if ((vertexAt(t, ix + o[0], iz + o[1]) - p).dot(n) > convexMargin<S>()) return false;
+    if ((vertexAt(t, ix + o[0], iz + o[1]) - p).dot(n) > margin) return false;
   return true;
 }
 
@@ -41,7 +60,7 @@ bool vertexIsExtreme(const Terrain<S>& t, int64_t ix, int64_t iz, const Vec3<S>&
 /// with the box's rocking: sideways pushes that turned a sliding box 5 cm off its line.
 template <class S>
 bool vertexIsPlanar(const Terrain<S>& t, int64_t ix, int64_t iz) {
-  const S h = t.heightOfSample(ix, iz), margin = convexMargin<S>();
+  const S h = t.heightOfSample(ix, iz), margin = planarMargin<S>();
   const S stepX = t.heightOfSample(ix + 1, iz) - h, stepZ = t.heightOfSample(ix, iz + 1) - h;
   return abs(S(h - t.heightOfSample(ix - 1, iz) - stepX)) <= margin &&
          abs(S(h - t.heightOfSample(ix, iz - 1) - stepZ)) <= margin &&
@@ -96,8 +115,10 @@ int spherePlaneUnderCentre(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>&
 
 /// Edge a-b of the ground against centre c: the closest point strictly inside the edge (its ends
 /// are the vertices' business), within `reach`, where the third corners f1, f2 of the edge's two
-/// triangles lie below the plane through that point normal to c - p by more than the margin (a
-/// convex crease; planar or concave ground leaves the contact to its faces).
+/// triangles lie no more than the margin above the plane through that point normal to c - p: a
+/// convex crease, however gentle (the centre is then in the wedge between its faces' regions,
+/// which only the edge covers). Over planar or concave ground c - p leans towards one corner,
+/// which then lies above that plane: the faces hold the body there.
 template <class S>
 bool edgeContact(const Terrain<S>& t, const Vec3<S>& c, S reach, const Vec3<S>& a, const Vec3<S>& b, int64_t f1x,
                  int64_t f1z, int64_t f2x, int64_t f2z, Vec3<S>* normal, S* dist) {
@@ -110,8 +131,8 @@ bool edgeContact(const Terrain<S>& t, const Vec3<S>& c, S reach, const Vec3<S>& 
   *dist = length3(d.x(), d.y(), d.z());
   if (!(*dist < reach) || *dist == S(0)) return false;
   *normal = d / *dist;
-  return (vertexAt(t, f1x, f1z) - p).dot(*normal) < -convexMargin<S>() &&
-         (vertexAt(t, f2x, f2z) - p).dot(*normal) < -convexMargin<S>();
+  const S margin = convexMargin(t);
+  return (vertexAt(t, f1x, f1z) - p).dot(*normal) < margin && (vertexAt(t, f2x, f2z) - p).dot(*normal) < margin;
 }
 
 /// Face (v, slopes) of cell (ix, iz): the centre's foot on its plane when that foot lies in the
@@ -132,6 +153,10 @@ bool faceContact(const Terrain<S>& t, const Vec3<S>& c, S reach, const Vec3<S>& 
 /// Most cells a sphere's reach may span along an axis before it takes the plane under its centre
 /// instead (a fast or huge sphere over fine cells: the cost is the square of this).
 constexpr int64_t kMaxReachCells = 64;
+
+/// Most cells a box's bounding sphere may span along an axis for its vertex scan (a 5 m box over
+/// 5 cm cells is 200): beyond it the box meets the ground with its corners only.
+constexpr int64_t kMaxBoxCells = 256;
 
 }  // namespace
 
@@ -219,16 +244,24 @@ int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Ter
   // which it is the ground's extreme point. On planar ground that is only the face lying on the
   // ground (no side face: a side face pointing up a slope was the ghost that stopped boxes
   // sliding over fine heightmaps); none at all when the box is not flat on it.
+  // Beyond the map and its two-cell margin the ground does not change along that axis: the box
+  // moves in to where its bounding sphere just meets the margin (as the sphere's centre does),
+  // so ridges that extend beyond the edge still hold it and the scan stays short and in range;
+  // the contact points move back.
   const S radius = ha.norm();
-  const Vec3<S>& centre = pa.position;
-  const int64_t i0 = terrain.cellX(std::clamp(S(centre.x() - radius), terrain.lowX(), terrain.highX()));
-  const int64_t i1 = terrain.cellX(std::clamp(S(centre.x() + radius), terrain.lowX(), terrain.highX())) + 1;
-  const int64_t j0 = terrain.cellZ(std::clamp(S(centre.z() - radius), terrain.lowZ(), terrain.highZ()));
-  const int64_t j1 = terrain.cellZ(std::clamp(S(centre.z() + radius), terrain.lowZ(), terrain.highZ())) + 1;
+  Pose<S> pose = pa;
+  pose.position.x() = std::clamp(pa.position.x(), S(terrain.lowX() - radius), S(terrain.highX() + radius));
+  pose.position.z() = std::clamp(pa.position.z(), S(terrain.lowZ() - radius), S(terrain.highZ() + radius));
+  const Vec3<S> shift = pa.position - pose.position;
+  const int64_t i0 = terrain.cellX(S(pose.position.x() - radius)),
+                i1 = terrain.cellX(S(pose.position.x() + radius)) + 1;
+  const int64_t j0 = terrain.cellZ(S(pose.position.z() - radius)),
+                j1 = terrain.cellZ(S(pose.position.z() + radius)) + 1;
+  if (i1 - i0 > kMaxBoxCells || j1 - j0 > kMaxBoxCells) return added;  // a huge box over fine cells: corners only
   for (int64_t j = j0; j <= j1; ++j)
     for (int64_t i = i0; i <= i1; ++i) {
       const Vec3<S> v = vertexAt(terrain, i, j);
-      const Vec3<S> local = pa.toLocal(v);
+      const Vec3<S> local = pose.toLocal(v);
       if (abs(local.x()) >= ha.x() || abs(local.y()) >= ha.y() || abs(local.z()) >= ha.z()) continue;
       if (vertexIsPlanar(terrain, i, j)) continue;
       int bestFace = -1;
@@ -241,7 +274,7 @@ int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Ter
         if (bestFace >= 0 && !(depth < bestDepth)) continue;
         Vec3<S> outward = Vec3<S>::Zero();
         outward[axis] = side;
-        const Vec3<S> n = -(pa.rotation * outward);  // the ground pushes the box away from that face
+        const Vec3<S> n = -(pose.rotation * outward);  // the ground pushes the box away from that face
         if (!vertexIsExtreme(terrain, i, j, v, n)) continue;
         bestFace = face;
         bestDepth = depth;
@@ -255,7 +288,7 @@ int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Ter
       c.featureB = featureKey(kVertex, i, j);
       c.normal = bestNormal;
       c.penetration = bestDepth;
-      c.point = v;
+      c.point = v + shift;
       out.push_back(c);
       ++added;
     }
