@@ -439,6 +439,11 @@ TEST_P(ScenarioScalarRange, RejectedExactlyByScalarsThatCannotHoldIt) {
 }
 
 const std::vector<ScalarCase> kScalarCases = {
+    // A contact frequency fx32 rounds to 0 (2.3e-10 resolution), fx16 too; float and double hold it.
+    {"ContactHertzRoundsToZero",
+     R"({"bodies": {"contactHertz": 1e-12, "list": [{"name": "b", "shape": {"type": "sphere", "radius": 0.5}}]}})",
+     "$.bodies.contactHertz",
+     {ScalarKind::Fx32, ScalarKind::Fx16}},
     // 100 patches 1000 m apart reach 51 km from the centre: beyond fx16's 8 km, inside fx32's.
     {"FieldBeyondFx16",
      R"({"field": {"patchesX": 100, "patchesZ": 100, "spacing": 1000}})",

@@ -105,8 +105,12 @@ void checkResolution(const Scenario& s) {
           std::string(what) + " that does not round to zero in " + scalarName(T::kind) + ", got " + r.toString());
   };
   nonZero(s.timeStep, "$.timeStep", "a time step");
-  if (!s.bodies.list.empty())  // the soft step's sub-step h = timeStep / substeps (world.cpp)
+  if (!s.bodies.list.empty()) {  // the soft step's sub-step h = timeStep / substeps (world.cpp)
     nonZero(*div(s.timeStep, Rational{s.bodies.substeps, 1}), "$.bodies.substeps", "a sub-step (timeStep / substeps)");
+    // A spring of 0 Hz would be taken as a rigid contact without push-out (makeSoftness): a
+    // frequency the scalar rounds to zero is an error, not that switch.
+    nonZero(s.bodies.contactHertz, "$.bodies.contactHertz", "a contact frequency");
+  }
   nonZero(s.field.spacing, "$.field.spacing", "a spacing");
   nonZero(s.particles.constraintLength, "$.particles.constraintLength", "a constraint length");
   nonZero(s.wind.travelSpeed, "$.wind.travelSpeed", "a travel speed");
