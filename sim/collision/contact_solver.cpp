@@ -52,10 +52,14 @@ Vec3<S> frictionDirection(const Vec3<S>& n, const RigidBody<S>& A, const RigidBo
   return tangential / length;
 }
 
-/// v clamped to [-limit, limit].
+/// A friction impulse given along axes (a1, a2) expressed along (b1, b2), both pairs orthonormal
+/// in the same tangent plane (warm starting between fixed and sliding axes).
 template <class S>
-S clampMagnitude(S v, S limit) {
-  return v < -limit ? -limit : (v > limit ? limit : v);
+void turnFriction(const Vec3<S>& a1, const Vec3<S>& a2, S along1, S along2, const Vec3<S>& b1, const Vec3<S>& b2,
+                  S* out1, S* out2) {
+  const Vec3<S> friction = a1 * along1 + a2 * along2;
+  *out1 = friction.dot(b1);
+  *out2 = friction.dot(b2);
 }
 
 /// sqrt of a non-negative v (0 for a rounding-negative one).
@@ -187,10 +191,9 @@ void matchCachedImpulses(const std::vector<Contact<S>>& contacts, const std::vec
     rows[i].t1.impulse = hit.tangent1;
     rows[i].t2.impulse = hit.tangent2;
     if (rows[i].slidingAxes) {  // the cache holds the fixed axes' impulses: turn them onto the sliding axes
-      const Vec3<S> fixed1 = tangentOf(rows[i].normal.dir), fixed2 = rows[i].normal.dir.cross(fixed1);
-      const Vec3<S> friction = fixed1 * hit.tangent1 + fixed2 * hit.tangent2;
-      rows[i].t1.impulse = friction.dot(rows[i].t1.dir);
-      rows[i].t2.impulse = friction.dot(rows[i].t2.dir);
+      const Vec3<S> fixed1 = tangentOf(rows[i].normal.dir);
+      turnFriction(fixed1, Vec3<S>(rows[i].normal.dir.cross(fixed1)), hit.tangent1, hit.tangent2, rows[i].t1.dir,
+                   rows[i].t2.dir, &rows[i].t1.impulse, &rows[i].t2.impulse);
     }
   }
 }
@@ -300,7 +303,7 @@ void solveContacts(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>
       // impulses that cancel between them (nothing in the sweep removes those) at 6 % of the
       // cone: the box slid with 94 % of its kinetic friction, 4 times too far near the
       // friction angle.
-      const S total1 = clampMagnitude(wanted1, limit);
+      const S total1 = std::clamp(wanted1, S(-limit), limit);
       applyAxisImpulse(bodies, row, row.t1, S(total1 - row.t1.impulse));
       row.t1.impulse = total1;
       const S wanted2 = row.t2.impulse - axisVelocity(bodies, row, row.t2) * row.t2.mass;
@@ -308,7 +311,7 @@ void solveContacts(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>
       // sqrt(limit^2 - t1^2) as a product of roots: (limit - |t1|)(limit + |t1|) of an 8 t block's
       // impulses overflows fx16.
       const S left = sqrtS(S(limit - used)) * sqrtS(S(limit + used));
-      const S total2 = clampMagnitude(wanted2, left);
+      const S total2 = std::clamp(wanted2, S(-left), left);
       applyAxisImpulse(bodies, row, row.t2, S(total2 - row.t2.impulse));
       row.t2.impulse = total2;
       continue;
@@ -403,10 +406,9 @@ void storeImpulses(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<
     const ContactRow<S>& row = rows[i];
     S tangent1 = row.t1.impulse, tangent2 = row.t2.impulse;
     if (row.slidingAxes) {  // back onto the fixed axes, which the next tick's rows start from
-      const Vec3<S> fixed1 = tangentOf(row.normal.dir), fixed2 = row.normal.dir.cross(fixed1);
-      const Vec3<S> friction = row.t1.dir * row.t1.impulse + row.t2.dir * row.t2.impulse;
-      tangent1 = friction.dot(fixed1);
-      tangent2 = friction.dot(fixed2);
+      const Vec3<S> fixed1 = tangentOf(row.normal.dir);
+      turnFriction(row.t1.dir, row.t2.dir, row.t1.impulse, row.t2.impulse, fixed1,
+                   Vec3<S>(row.normal.dir.cross(fixed1)), &tangent1, &tangent2);
     }
     cache.push_back(CachedImpulse<S>{contacts[i].bodyA, contacts[i].bodyB, contacts[i].featureA, contacts[i].featureB,
                                      row.normal.impulse, tangent1, tangent2, contacts[i].point});
