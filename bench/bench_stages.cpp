@@ -146,6 +146,7 @@ void BM_BroadPhase(benchmark::State& state) {
   S largest(0);
   for (const auto& b : world.bodies()) largest = b.boundingRadius > largest ? b.boundingRadius : largest;
   settings.margin = world.particleConstants().rodLength + world.lattice().jitterAmplitude + largest;
+  settings.pushAllowance = largest;
   settings.anchorOriginX = world.lattice().originX;
   settings.anchorOriginZ = world.lattice().originZ;
   settings.invParticleSpacing = S(1) / world.lattice().spacing;
@@ -154,7 +155,8 @@ void BM_BroadPhase(benchmark::State& state) {
   int64_t candidates = 0;
   for (auto _ : state) {
     const sg::GrassPushers<S> pushers = sg::prepareGrassPushers(world.bodies(), grid, settings);
-    benchmark::DoNotOptimize(sg::pushParticlesOutOfBodies(particles, grid, pushers, settings, 0, grid.countZ, nullptr));
+    benchmark::DoNotOptimize(sg::pushParticlesOutOfBodies(particles, grid, pushers, settings, 0, grid.countZ, nullptr,
+                                                          sg::defaultParticleKernel()));
     candidates = 0;
     for (const sg::GrassPusher<S>& p : pushers.parts)
       candidates += (p.range.a1 - p.range.a0 + 1) * (p.range.b1 - p.range.b0 + 1);

@@ -58,7 +58,11 @@ struct RigidBody {
     rotation = orientation.toRotationMatrix();
     invInertiaWorld = rotation * invInertiaLocal.asDiagonal() * rotation.transpose();
   }
-  Pose<S> partPose(size_t i) const { return Pose<S>{position + rotation * parts[i].offset, rotation}; }
+  Pose<S> partPose(size_t i) const {
+    // A part at the centre of mass (every single-part body) skips the rotation: R 0 is exactly 0.
+    if (parts[i].offset == Vec3<S>::Zero()) return Pose<S>{position, rotation};
+    return Pose<S>{position + rotation * parts[i].offset, rotation};
+  }
 };
 
 /// Builds a body from its scenario description. Mass properties are exact fractions, rounded

@@ -1,7 +1,9 @@
 #include "sim/collision/body_particles.h"
 
 #include <algorithm>
+#include <vector>
 
+#include "sim/collision/grass_candidates.h"
 #include "sim/math/scalar_ops.h"
 
 namespace sg {
@@ -33,18 +35,36 @@ std::vector<ParticleRange> particleRanges(const std::vector<RigidBody<S>>& bodie
   return out;
 }
 
+namespace {
+
+/// Half-side (m) of the cube around a part's centre outside which no particle is pushed. A sphere:
+/// its radius. A box: its bounding radius with a slack (an eighth of it and 4 mm) for the rounding
+/// of the rotation in the exact test (relative errors of a few 1e-5 in Fx16), so the pre-test
+/// never refuses a particle the box test would push.
+template <class S>
+S candidateReach(const BodyPart<S>& shape) {
+  if (shape.type == ShapeType::Sphere) return shape.radius;
+  return shape.boundingRadius + shape.boundingRadius / S(8) + S(1) / S(256);
+}
+
+}  // namespace
+
 template <class S>
 GrassPushers<S> prepareGrassPushers(const std::vector<RigidBody<S>>& bodies, const ParticleGrid& grid,
                                     const BodyParticleSettings<S>& settings) {
   GrassPushers<S> out;
   const std::vector<ParticleRange> ranges = particleRanges(bodies, grid, settings);
+  out.parts.reserve(ranges.size());
   size_t rangeIndex = 0;
   for (size_t bodyIndex = 0; bodyIndex < bodies.size(); ++bodyIndex) {
     const RigidBody<S>& body = bodies[bodyIndex];
     const S share = settings.particleInvMass / (settings.particleInvMass + body.invMass);
-    for (size_t part = 0; part < body.parts.size(); ++part, ++rangeIndex)
-      out.parts.push_back(
-          GrassPusher<S>{body.partPose(part), &body.parts[part], share, ranges[rangeIndex], int32_t(bodyIndex)});
+    for (size_t part = 0; part < body.parts.size(); ++part, ++rangeIndex) {
+      const BodyPart<S>& shape = body.parts[part];
+      out.parts.push_back(GrassPusher<S>{body.partPose(part), &shape, share, ranges[rangeIndex],
+                                         grid.window.storageColumn(ranges[rangeIndex].a0), candidateReach(shape),
+                                         int32_t(bodyIndex)});
+    }
   }
   // Counting sort of (row, part) pairs by row: parts stay in (body, part) order within a row.
   const LatticeWindow& w = grid.window;
@@ -67,7 +87,8 @@ GrassPushers<S> prepareGrassPushers(const std::vector<RigidBody<S>>& bodies, con
 
 namespace {
 
-/// Pushes one particle out of a sphere or box part; returns whether it was inside.
+/// Pushes one particle out of a sphere or box part; returns whether it was inside. Called only for
+/// particles within the part's candidateReach (withinReach).
 template <class S>
 bool pushOut(ParticleArrays<S>& pa, size_t i, const GrassPusher<S>& pusher, BoxParticleNormal boxNormal) {
   const Vec3<S> p(pa.px[i], pa.py[i], pa.pz[i]);
@@ -75,7 +96,9 @@ bool pushOut(ParticleArrays<S>& pa, size_t i, const GrassPusher<S>& pusher, BoxP
   const Pose<S>& pose = pusher.pose;
   if (shape.type == ShapeType::Sphere) {
     const Vec3<S> d = p - pose.position;
-    if (abs(d.x()) >= shape.radius || abs(d.y()) >= shape.radius || abs(d.z()) >= shape.radius) return false;
+    // Most candidates inside the reach cube rest on the ball's surface, just outside it: decided
+    // without the square root (the same answer as comparing length3 below).
+    if (length3AtLeast(d.x(), d.y(), d.z(), shape.radius)) return false;
     const S dist = length3(d.x(), d.y(), d.z());
     if (dist >= shape.radius) return false;
     const Vec3<S> n = dist == S(0) ? Vec3<S>(Vec3<S>::UnitY()) : Vec3<S>(d / dist);
@@ -105,35 +128,163 @@ bool pushOut(ParticleArrays<S>& pa, size_t i, const GrassPusher<S>& pusher, BoxP
 
 }  // namespace
 
+namespace {
+
+/// The columns firstColumn .. firstColumn + count - 1 of a toroidal row, as runs within one
+/// 64-column word each, in order (the window wraps at most once): calls run(c0, c1, word) for
+/// storage columns [c0, c1) of word c0 / 64, and stops at the first index it returns (>= 0).
+template <class Run>
+int64_t forEachWordRun(int64_t countX, int64_t firstColumn, int64_t count, Run&& run) {
+  int64_t column = firstColumn;
+  while (count > 0) {
+    const int64_t end = std::min(countX, column + count);
+    count -= end - column;
+    for (int64_t c0 = column; c0 < end;) {
+      const int64_t c1 = std::min(end, (c0 / 64 + 1) * 64);
+      const int64_t stop = run(c0, c1);
+      if (stop >= 0) return stop;
+      c0 = c1;
+    }
+    column = 0;
+  }
+  return -1;
+}
+
+/// Whether four or more bits are set (no popcount instruction in the baseline x86-64 build).
+inline bool atLeastFourBits(uint64_t bits) {
+  for (int k = 0; k < 3; ++k) bits &= bits - 1;
+  return bits != 0;
+}
+
+/// Whether a coordinate moved by `limit` or more from where it started (or so far that the
+/// difference leaves the format: no fault is raised here, the caller treats it as moved).
+template <class S>
+bool movedAtLeast(S now, S start, S limit) {
+  if constexpr (ScalarTraits<S>::isFixed) {
+    decltype(now.raw()) d;
+    if (__builtin_sub_overflow(now.raw(), start.raw(), &d)) return true;
+    return d >= limit.raw() || -d >= limit.raw();
+  } else {
+    return !(abs(now - start) < limit);
+  }
+}
+
+}  // namespace
+
 template <class S>
 int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid, const GrassPushers<S>& pushers,
                                  const BodyParticleSettings<S>& s, int64_t rowBegin, int64_t rowEnd,
-                                 int64_t* pushedPerBody) {
+                                 int64_t* pushedPerBody, ParticleKernel kernel) {
   using T = ScalarTraits<S>;
+  // Scratch reused across calls: the rows' height marks (grass_candidates.h, fixed-point only),
+  // which particles of the row moved and where they stood before their first push, and which of
+  // them left the ranges.
+  thread_local std::vector<uint64_t> marks, escaped, moved;
+  thread_local std::vector<S> startX, startZ;
+  const bool useMarks = T::isFixed && s.heightMarks;
+  const bool vector = T::isFixed && kernel == ParticleKernel::Avx2;
+  const bool ranged = s.broadphase == ParticleBroadphase::Grid;
+  const size_t words = size_t((grid.countX + 63) / 64);
+  if (useMarks) marks.resize(words);
+  if (ranged) {
+    escaped.resize(words);
+    moved.resize(words);
+    startX.resize(size_t(grid.countX));
+    startZ.resize(size_t(grid.countX));
+  }
+  // One particle pushed out of a part it is within reach of; false where the stage must stop.
+  const auto pushInside = [&](size_t i, const GrassPusher<S>& pusher) {
+    if (!pushOut(pa, i, pusher, s.boxNormal)) return true;
+    if (pushedPerBody) ++pushedPerBody[pusher.body];
+    return !T::faultPending() && T::isFinite(pa.px[i]) && T::isFinite(pa.py[i]) && T::isFinite(pa.pz[i]);
+  };
   // Storage rows [rowBegin, rowEnd): each holds one lattice row of the window. Per particle the
   // parts apply in (body, part) order, as the bucket keeps them: the same bits as any order of
-  // rows, any thread count and either broad phase.
+  // rows, any thread count and either broad phase. A row's marks stay valid while its parts push:
+  // an unmarked particle is outside every part's reach, so none moves it.
   for (int64_t row = rowBegin; row < rowEnd; ++row) {
     const int64_t b = grid.window.latticeRow(row) - pushers.originJ;
-    for (int64_t k = pushers.rowStart[size_t(b)]; k < pushers.rowStart[size_t(b + 1)]; ++k) {
-      const GrassPusher<S>& pusher = pushers.parts[size_t(pushers.byRow[size_t(k)])];
-      const ParticleRange& r = pusher.range;
-      const bool sphere = pusher.shape->type == ShapeType::Sphere;
-      const S cx = pusher.pose.position.x(), cy = pusher.pose.position.y(), cz = pusher.pose.position.z();
-      const S radius = pusher.shape->radius;
-      int64_t column = grid.window.storageColumn(r.a0);
-      for (int64_t a = r.a0; a <= r.a1; ++a, column = column + 1 == grid.countX ? 0 : column + 1) {
-        const size_t i = size_t(row * grid.countX + column);
-        // Most candidates of a sphere miss it on one axis (a tuft's tip above a ball in the
-        // grass): rejected here, before pushOut's call and its loads of the pose.
-        if (sphere &&
-            (abs(S(pa.py[i] - cy)) >= radius || abs(S(pa.px[i] - cx)) >= radius || abs(S(pa.pz[i] - cz)) >= radius))
-          continue;
-        if (!pushOut(pa, i, pusher, s.boxNormal)) continue;
-        if (pushedPerBody) ++pushedPerBody[pusher.body];
-        if (T::faultPending() || !(T::isFinite(pa.px[i]) && T::isFinite(pa.py[i]) && T::isFinite(pa.pz[i])))
-          return int64_t(i);
+    const int64_t firstPart = pushers.rowStart[size_t(b)], endPart = pushers.rowStart[size_t(b + 1)];
+    if (firstPart == endPart) continue;
+    const size_t rowBase = size_t(row * grid.countX);
+    if constexpr (T::isFixed) {
+      if (useMarks) {
+        HeightBand<S> band;
+        for (int64_t k = firstPart; k < endPart; ++k) {
+          const GrassPusher<S>& pusher = pushers.parts[size_t(pushers.byRow[size_t(k)])];
+          band.add(pusher.pose.position.y(), pusher.candidateReach);
+        }
+        markHeightBand(&pa.py[rowBase], grid.countX, band, kernel, marks.data());
+        // No particle in the band: none is within any part's reach (tall grass over lying bodies).
+        if (std::all_of(marks.begin(), marks.end(), [](uint64_t w) { return w == 0; })) continue;
       }
+    }
+    bool anyEscaped = false;
+    if (ranged) std::fill(moved.begin(), moved.end(), uint64_t(0));
+    for (int64_t k = firstPart; k < endPart; ++k) {
+      const int32_t part = pushers.byRow[size_t(k)];
+      const GrassPusher<S>& pusher = pushers.parts[size_t(part)];
+      const S cx = pusher.pose.position.x(), cy = pusher.pose.position.y(), cz = pusher.pose.position.z();
+      const S reach = pusher.candidateReach;
+      // The rare path, out of the hot loop: a particle inside the part.
+      const auto pushAndFollow = [&](size_t i) {
+        const size_t column = i - rowBase;
+        const uint64_t bit = uint64_t(1) << (column % 64);
+        if (anyEscaped && (escaped[column / 64] & bit)) return true;
+        const S x = pa.px[i], z = pa.pz[i];
+        if (!pushInside(i, pusher)) return false;
+        if (!ranged || (pa.px[i] == x && pa.pz[i] == z)) return true;
+        if (!(moved[column / 64] & bit)) {  // its first push this tick: where it started
+          moved[column / 64] |= bit;
+          startX[column] = x;
+          startZ[column] = z;
+        }
+        // The ranges allow for a particle within a rod of its anchor moved by less than the
+        // largest radius this tick. A chain of pushes (bodies piled in a line) can carry it
+        // further: then it meets every later part in order here, as brute force would, and the
+        // row's later parts pass it by.
+        if (!movedAtLeast(pa.px[i], startX[column], s.pushAllowance) &&
+            !movedAtLeast(pa.pz[i], startZ[column], s.pushAllowance))
+          return true;
+        if (!anyEscaped) std::fill(escaped.begin(), escaped.end(), uint64_t(0));
+        anyEscaped = true;
+        escaped[column / 64] |= bit;
+        for (size_t later = size_t(part) + 1; later < pushers.parts.size(); ++later) {
+          const GrassPusher<S>& next = pushers.parts[later];
+          const Vec3<S>& c = next.pose.position;
+          if (withinReach(pa.px[i], pa.py[i], pa.pz[i], c.x(), c.y(), c.z(), next.candidateReach) &&
+              !pushInside(i, next))
+            return false;
+        }
+        return true;
+      };
+      const int64_t fault = forEachWordRun(
+          grid.countX, pusher.firstColumn, pusher.range.a1 - pusher.range.a0 + 1,
+          [&](int64_t c0, int64_t c1) -> int64_t {
+            const int64_t word = c0 / 64;
+            uint64_t bits = useMarks ? marks[size_t(word)] : ~uint64_t(0);
+            bits &= (~uint64_t(0) << (c0 - word * 64)) & (~uint64_t(0) >> (word * 64 + 64 - c1));
+            if (bits == 0) return -1;
+            // Four or more to test: the vector pre-test of the run (the same answers, fixed-point).
+            bool tested = false;
+            if constexpr (T::isFixed) {
+              uint64_t inside = 0;
+              const size_t first = rowBase + size_t(c0);
+              if (vector && atLeastFourBits(bits) &&
+                  withinReachMask(&pa.px[first], &pa.py[first], &pa.pz[first], int(c1 - c0), pusher.pose.position,
+                                  reach, &inside)) {
+                bits &= inside << (c0 - word * 64);
+                tested = true;
+              }
+            }
+            for (; bits != 0; bits &= bits - 1) {
+              const size_t i = rowBase + size_t(word * 64 + __builtin_ctzll(bits));
+              if ((tested || withinReach(pa.px[i], pa.py[i], pa.pz[i], cx, cy, cz, reach)) && !pushAndFollow(i))
+                return int64_t(i);
+            }
+            return -1;
+          });
+      if (fault >= 0) return fault;
     }
   }
   return -1;
@@ -145,7 +296,8 @@ int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid
   template GrassPushers<S> prepareGrassPushers(const std::vector<RigidBody<S>>&, const ParticleGrid&,        \
                                                const BodyParticleSettings<S>&);                              \
   template int64_t pushParticlesOutOfBodies(ParticleArrays<S>&, const ParticleGrid&, const GrassPushers<S>&, \
-                                            const BodyParticleSettings<S>&, int64_t, int64_t, int64_t*);
+                                            const BodyParticleSettings<S>&, int64_t, int64_t, int64_t*,      \
+                                            ParticleKernel);
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE)
 #undef SG_INSTANTIATE
 }  // namespace sg

@@ -9,15 +9,21 @@
 //
 // Broad phase "grid" (the thesis' lattice ranges) tests only particles whose anchor lies within
 // boundingRadius + margin of a part's centre, on both axes. margin = rod length + jitter + the
-// largest bounding radius of all bodies: a particle is within L of its anchor after the
-// constraint stage and a push this tick moves it by at most one part's radius, so no particle that
-// "brute" would push is ever skipped. Tests check both give bit-identical states.
+// largest bounding radius of all bodies (pushAllowance): a particle is within L of its anchor
+// after the constraint stage and one push moves it by less than one part's radius. A chain of
+// pushes (bodies piled in a line, each pushing the tip out of its far side into the next) can
+// carry it further; a particle that has moved pushAllowance or more on x or z this tick is taken
+// out of the ranges and meets every later part in order, as brute force does. So no particle that
+// "brute" would push is ever skipped, and both give bit-identical states (tests: Bodies.
+// BroadPhasesAreBitIdentical, GrassCandidates.ChainedPushesReachTheSameBodiesInEveryBroadPhase).
+// Candidates are filtered by the height band of each row's parts first (grass_candidates.h).
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
 #include "sim/bodies/rigid_body.h"
+#include "sim/particles/particle_kernel.h"
 #include "sim/particles/particles.h"
 
 namespace sg {
@@ -33,8 +39,12 @@ struct BodyParticleSettings {
   ParticleBroadphase broadphase = ParticleBroadphase::Grid;
   S particleInvMass{1};
   S margin{};                          ///< m, see above
+  S pushAllowance{};                   ///< m: the largest bounding radius, the part of margin a push may use
   S anchorOriginX{}, anchorOriginZ{};  ///< m, un-jittered position of particle (0, 0)
   S invParticleSpacing{};              ///< 1 / (k spacing)
+  /// The rows' height marks (grass_candidates.h), fixed-point only. They change no bits; off only
+  /// in the tests that check exactly that.
+  bool heightMarks = true;
 };
 
 /// Candidate ranges for every body part, in (body, part) order.
@@ -50,6 +60,8 @@ struct GrassPusher {
   const BodyPart<S>* shape = nullptr;
   S share{};
   ParticleRange range;
+  int64_t firstColumn = 0;  ///< storage column of range.a0 (the same for every row: computed once)
+  S candidateReach{};       ///< m: particles farther from the centre on any axis are not pushed
   int32_t body = 0;
 };
 
@@ -73,10 +85,10 @@ GrassPushers<S> prepareGrassPushers(const std::vector<RigidBody<S>>& bodies, con
 
 /// Applies every pusher to particle rows [rowBegin, rowEnd) (storage rows). Adds the number of
 /// particles each body pushed to pushedPerBody[body] (may be null). Returns the first faulting
-/// particle or -1.
+/// particle or -1. `kernel` picks the pre-test (grass_candidates.h): the same bits either way.
 template <class S>
 int64_t pushParticlesOutOfBodies(ParticleArrays<S>& particles, const ParticleGrid& grid, const GrassPushers<S>& pushers,
                                  const BodyParticleSettings<S>& settings, int64_t rowBegin, int64_t rowEnd,
-                                 int64_t* pushedPerBody);
+                                 int64_t* pushedPerBody, ParticleKernel kernel);
 
 }  // namespace sg

@@ -106,7 +106,7 @@ bool World<S>::respondToContacts() {
   std::vector<int64_t> pushed(drag ? size_t(grid_.countZ) * bodies_.size() : 0, 0);
   const bool ok = runParticleRows(Stage::Response, [&](int64_t row, int64_t, int64_t) {
     return pushParticlesOutOfBodies(particles_, grid_, pushers, bodyParticle_, row, row + 1,
-                                    drag ? pushed.data() + size_t(row) * bodies_.size() : nullptr);
+                                    drag ? pushed.data() + size_t(row) * bodies_.size() : nullptr, particleKernel_);
   });
   if (!ok || !drag) return ok;
   for (size_t b = 0; b < bodies_.size(); ++b) {

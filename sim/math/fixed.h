@@ -336,6 +336,21 @@ inline Fixed<R, W, F> length3(Fixed<R, W, F> x, Fixed<R, W, F> y, Fixed<R, W, F>
   return detail::length3With<detail::RadicandOf<W>>(x, y, z);
 }
 
+/// Whether length3(x, y, z) >= r, exactly, without the square root (for r > 0): length3 rounds
+/// to nearest with no ties, so it reaches r exactly when the sum of squares N of the raw values
+/// is at least r^2 - r + 1 (raw units). The sum must fit as in length3 (coordinates within a
+/// quarter of the range).
+template <class R, class W, int F>
+inline bool length3AtLeast(Fixed<R, W, F> x, Fixed<R, W, F> y, Fixed<R, W, F> z, Fixed<R, W, F> r) noexcept {
+  using U = detail::RadicandOf<W>;
+  const auto sq = [](R v) {
+    const U m = v < 0 ? U(0) - U(v) : U(v);
+    return m * m;
+  };
+  const U radius = static_cast<U>(r.raw());
+  return sq(x.raw()) + sq(y.raw()) + sq(z.raw()) >= radius * radius - radius + U(1);
+}
+
 template <class R, class W, int F>
 constexpr Fixed<R, W, F> min(Fixed<R, W, F> a, Fixed<R, W, F> b) noexcept {
   return b < a ? b : a;

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <optional>
 #include <string_view>
+#include <type_traits>
 
 #include "sim/math/fixed.h"
 #include "sim/math/rational.h"
@@ -88,6 +89,10 @@ inline float abs(float v) { return std::fabs(v); }
 inline double abs(double v) { return std::fabs(v); }
 inline float length3(float x, float y, float z) { return std::sqrt(x * x + y * y + z * z); }
 inline double length3(double x, double y, double z) { return std::sqrt(x * x + y * y + z * z); }
+/// Whether length3(x, y, z) >= r (floating point: the square root itself, so the same answer).
+template <class F>
+requires std::is_floating_point_v<F>
+inline bool length3AtLeast(F x, F y, F z, F r) { return length3(x, y, z) >= r; }
 
 /// Expands M(S) once per scalar type: explicit template instantiations in the .cpp files.
 #define SG_FOR_EACH_SCALAR(M) M(::sg::Fx32) M(::sg::Fx16) M(float) M(double)

@@ -159,6 +159,7 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   S largest(0);
   for (const RigidBody<S>& b : bodies_) largest = maxS(largest, b.boundingRadius);
   bodyParticle_.margin = particleConsts_.rodLength + lattice_.jitterAmplitude + largest;
+  bodyParticle_.pushAllowance = largest;
   bodyParticle_.anchorOriginX = lattice_.originX;
   bodyParticle_.anchorOriginZ = lattice_.originZ;
   bodyParticle_.invParticleSpacing = toS<S>(c.invParticleSpacing);
