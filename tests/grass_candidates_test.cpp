@@ -214,7 +214,7 @@ PushResult pushOnce(const World<S>& world, std::vector<RigidBody<S>> bodies, Par
 }
 
 template <class S>
-void marksChangeNothing(const World<S>& world) {
+void marksChangeNothing(const World<S>& world, int centreX = 0, int centreZ = 0) {
   using Raw = typename HeightBand<S>::Raw;
   const auto metres = [](int64_t mm) { return S(int(mm)) / S(1000); };
   // Bodies low in the grass, overlapping in the same rows at different heights; rarely one or three
@@ -222,8 +222,8 @@ void marksChangeNothing(const World<S>& world) {
   // eighths of it: there the reference's y difference may overflow, and the marks must raise the same fault.
   std::vector<RigidBody<S>> bodies = world.bodies();
   for (RigidBody<S>& b : bodies) {
-    b.position = Vec3<S>(metres(*rc::gen::inRange(-3000, 3000)), metres(*rc::gen::inRange(-300, 1500)),
-                         metres(*rc::gen::inRange(-3000, 3000)));
+    b.position = Vec3<S>(metres(centreX * 1000 + *rc::gen::inRange(-3000, 3000)), metres(*rc::gen::inRange(-300, 1500)),
+                         metres(centreZ * 1000 + *rc::gen::inRange(-3000, 3000)));
     if (*rc::gen::inRange(0, 12) == 0)
       b.position.y() =
           S::fromRaw(Raw(*rc::gen::element<int>(1, -1)) *
@@ -270,6 +270,37 @@ TEST(GrassCandidates, HeightMarksChangeNoBitsAndNoFault) {
   const auto fx16 = test::makeTyped<Fx16>(smallMeadowWithBodies());
   EXPECT_TRUE(rc::check("fx32", [&] { marksChangeNothing(*fx32); }));
   EXPECT_TRUE(rc::check("fx16", [&] { marksChangeNothing(*fx16); }));
+}
+
+// The level of detail's window is stored toroidally: once it has moved, a part's columns (and
+// brute force's whole row) wrap around the storage's end. The same checks there, with the bodies
+// around the seam.
+TEST(GrassCandidates, HeightMarksChangeNoBitsInAMovedWindow) {
+  Scenario s = loadScenarioFile(test::sourcePath("scenarios/lod-crossing.json"));
+  s.field.patchesX = s.field.patchesZ = 201;  // 50 m, column 0 at x = -25
+  s.lod.windowX = s.lod.windowZ = 41;         // 10 m
+  s.lod.centerGiven = true;
+  s.lod.centerX = s.lod.centerZ = Rational{-18, 1};
+  s.script.clear();
+  s.camera.clear();
+  const auto check = [&]<class S>(const char* name) {
+    auto world = test::makeTyped<S>(s);
+    const int64_t storageOrigin = world->particleGrid().window.storageColumn(world->particleGrid().window.originI);
+    TickInput in;
+    in.hasCamera = true;
+    in.camera = InputVec3{toInputRaw(Rational{-14, 1}), toInputRaw(Rational{2, 1}), toInputRaw(Rational{-15, 1})};
+    ASSERT_TRUE(world->step(in).ok);
+    const ParticleGrid& grid = world->particleGrid();
+    ASSERT_NE(grid.window.storageColumn(grid.window.originI), storageOrigin) << "the window moved along x";
+    ASSERT_NE(grid.window.storageRow(grid.window.originJ), 0) << "and along z";
+    // The seam: the lattice column stored in column 0, in metres.
+    const int64_t seam = grid.window.latticeColumn(0);
+    const int seamX =
+        int(std::lround(world->lattice().originX.toDouble() + double(seam) * world->lattice().spacing.toDouble()));
+    EXPECT_TRUE(rc::check(name, [&] { marksChangeNothing(*world, seamX, -15); }));
+  };
+  check.operator()<Fx32>("fx32");
+  check.operator()<Fx16>("fx16");
 }
 
 // Bodies piled in a line pass a tuft tip on: each pushes it out of its far side, into the next.
