@@ -307,6 +307,8 @@ TEST(GrassCandidates, HeightMarksChangeNoBitsInAMovedWindow) {
 // The lattice ranges allow for one push (margin = rod + jitter + the largest radius); a chain of
 // four heavy spheres carries the tip two radii further, to a sphere whose range does not hold
 // its anchor. Every broad phase must still push it exactly as brute force does.
+// Along x the chain stays in the tip's row; along z it runs through parts bucketed in other rows,
+// which only the escape's walk over every later part reaches.
 TEST(GrassCandidates, ChainedPushesReachTheSameBodiesInEveryBroadPhase) {
   Scenario scenario = test::thesisMeadow();
   scenario.field.patchesX = scenario.field.patchesZ = 40;
@@ -317,7 +319,7 @@ TEST(GrassCandidates, ChainedPushesReachTheSameBodiesInEveryBroadPhase) {
     b.mass = Rational{1000, 1};
     scenario.bodies.list.push_back(b);
   }
-  const auto check = [&]<class S>() {
+  const auto check = [&]<class S>(bool alongZ) {
     const auto world = test::makeTyped<S>(scenario);
     ParticleArrays<S> particles = world->particles();
     const size_t tip = particles.px.size() / 2 + 7;
@@ -326,11 +328,15 @@ TEST(GrassCandidates, ChainedPushesReachTheSameBodiesInEveryBroadPhase) {
     const auto cm = [](int v) { return S(v) / S(100); };
     // The tip lies almost flat (0.99 m out, 0.14 m up: within its 1 m rod), 1 cm past the
     // first sphere's centre; each next sphere sits 1 cm short of where the last one leaves it.
-    particles.px[tip] = ax + cm(99);
-    particles.py[tip] = ay + cm(14);
-    particles.pz[tip] = az;
+    const auto along = [&](int centimetres) {
+      return alongZ ? Vec3<S>(ax, ay + cm(14), az + cm(centimetres)) : Vec3<S>(ax + cm(centimetres), ay + cm(14), az);
+    };
+    const Vec3<S> start = along(99);
+    particles.px[tip] = start.x();
+    particles.py[tip] = start.y();
+    particles.pz[tip] = start.z();
     std::vector<RigidBody<S>> bodies = world->bodies();
-    for (size_t k = 0; k < bodies.size(); ++k) bodies[k].position = Vec3<S>(ax + cm(98 + 49 * int(k)), ay + cm(14), az);
+    for (size_t k = 0; k < bodies.size(); ++k) bodies[k].position = along(98 + 49 * int(k));
     const PushResult brute =
         pushOnce(*world, bodies, particles, true, ParticleKernel::Scalar, ParticleBroadphase::Brute);
     ASSERT_EQ(brute.pushed, std::vector<int64_t>(4, 1)) << "the chain passes the tip through all four";
@@ -341,9 +347,54 @@ TEST(GrassCandidates, ChainedPushesReachTheSameBodiesInEveryBroadPhase) {
         EXPECT_TRUE(grid.bytes == brute.bytes) << marks;
       }
   };
-  check.operator()<Fx32>();
-  check.operator()<Fx16>();
+  for (bool alongZ : {false, true}) {
+    check.operator()<Fx32>(alongZ);
+    check.operator()<Fx16>(alongZ);
+  }
 }
+
+// A box's pre-test reach (its bounding radius with a slack for the rotation's rounding) holds
+// every point the exact box test calls inside: points just inside the corners of boxes turned
+// every way, in Fx16 (the coarsest rotation) and Fx32.
+template <class S>
+void boxReachHoldsTheBox() {
+  const auto unit = [] { return S(*rc::gen::inRange(-1000, 1001)) / S(1000); };
+  RigidBody<S> body;
+  BodyPart<S> part;
+  part.type = ShapeType::Box;
+  part.halfExtents = Vec3<S>(S(*rc::gen::inRange(1, 3000)) / S(1000), S(*rc::gen::inRange(1, 3000)) / S(1000),
+                             S(*rc::gen::inRange(1, 3000)) / S(1000));
+  part.boundingRadius = length3(part.halfExtents.x(), part.halfExtents.y(), part.halfExtents.z());
+  body.parts = {part};
+  body.position = Vec3<S>(unit() * S(5), unit(), unit() * S(5));
+  const Quat<S> q(unit(), unit(), unit(), unit());
+  if (q.coeffs() != Quat<S>::Coefficients::Zero()) body.orientation = normalizedQuat(q);
+  body.updateDerived();
+  ParticleGrid grid;
+  grid.countX = grid.countZ = 1;
+  grid.window = LatticeWindow{0, 0, 1, 1, 1, 1};
+  BodyParticleSettings<S> settings;
+  settings.broadphase = ParticleBroadphase::Brute;
+  const GrassPushers<S> pushers = prepareGrassPushers(std::vector<RigidBody<S>>{body}, grid, settings);
+  const GrassPusher<S>& pusher = pushers.parts.at(0);
+  // A corner (each sign), pulled in by up to 3 raw units per axis, and turned into the world.
+  const Vec3<S>& h = part.halfExtents;
+  Vec3<S> local;
+  for (int axis = 0; axis < 3; ++axis) {
+    const S pullIn = S::fromRaw(*rc::gen::inRange(1, 4));
+    local[axis] = *rc::gen::arbitrary<bool>() ? S(h[axis] - pullIn) : S(pullIn - h[axis]);
+  }
+  const Vec3<S> p = pusher.pose.toWorld(local);
+  const Vec3<S> back = pusher.pose.toLocal(p);
+  const bool inside = abs(back.x()) < h.x() && abs(back.y()) < h.y() && abs(back.z()) < h.z();
+  RC_TAG(inside ? "inside" : "rounded outside");
+  if (!inside) return;
+  const Vec3<S>& c = pusher.pose.position;
+  RC_ASSERT(withinReach(p.x(), p.y(), p.z(), c.x(), c.y(), c.z(), pusher.candidateReach));
+}
+
+RC_GTEST_PROP(GrassCandidates, Fx16BoxReachHoldsTheBox, ()) { boxReachHoldsTheBox<Fx16>(); }
+RC_GTEST_PROP(GrassCandidates, Fx32BoxReachHoldsTheBox, ()) { boxReachHoldsTheBox<Fx32>(); }
 
 }  // namespace
 }  // namespace sg

@@ -1,6 +1,7 @@
 #include "sim/collision/body_particles.h"
 
 #include <algorithm>
+#include <type_traits>
 #include <vector>
 
 #include "sim/collision/grass_candidates.h"
@@ -131,8 +132,8 @@ bool pushOut(ParticleArrays<S>& pa, size_t i, const GrassPusher<S>& pusher, BoxP
 namespace {
 
 /// The columns firstColumn .. firstColumn + count - 1 of a toroidal row, as runs within one
-/// 64-column word each, in order (the window wraps at most once): calls run(c0, c1, word) for
-/// storage columns [c0, c1) of word c0 / 64, and stops at the first index it returns (>= 0).
+/// 64-column word each, in order (the window wraps at most once): calls run(c0, c1) for
+/// storage columns [c0, c1) (all in word c0 / 64), and stops at the first index it returns (>= 0).
 template <class Run>
 int64_t forEachWordRun(int64_t countX, int64_t firstColumn, int64_t count, Run&& run) {
   int64_t column = firstColumn;
@@ -163,7 +164,9 @@ bool movedAtLeast(S now, S start, S limit) {
   if constexpr (ScalarTraits<S>::isFixed) {
     decltype(now.raw()) d;
     if (__builtin_sub_overflow(now.raw(), start.raw(), &d)) return true;
-    return d >= limit.raw() || -d >= limit.raw();
+    using U = std::make_unsigned_t<decltype(d)>;
+    const U magnitude = d < 0 ? U(0) - U(d) : U(d);  // no negation of the most negative value
+    return limit.raw() <= 0 || magnitude >= U(limit.raw());
   } else {
     return !(abs(now - start) < limit);
   }
@@ -230,7 +233,6 @@ int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid
       const auto pushAndFollow = [&](size_t i) {
         const size_t column = i - rowBase;
         const uint64_t bit = uint64_t(1) << (column % 64);
-        if (anyEscaped && (escaped[column / 64] & bit)) return true;
         const S x = pa.px[i], z = pa.pz[i];
         if (!pushInside(i, pusher)) return false;
         if (!ranged || (pa.px[i] == x && pa.pz[i] == z)) return true;
@@ -264,6 +266,7 @@ int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid
             const int64_t word = c0 / 64;
             uint64_t bits = useMarks ? marks[size_t(word)] : ~uint64_t(0);
             bits &= (~uint64_t(0) << (c0 - word * 64)) & (~uint64_t(0) >> (word * 64 + 64 - c1));
+            if (anyEscaped) bits &= ~escaped[size_t(word)];  // already through every later part
             if (bits == 0) return -1;
             // Four or more to test: the vector pre-test of the run (the same answers, fixed-point).
             bool tested = false;

@@ -338,8 +338,8 @@ inline Fixed<R, W, F> length3(Fixed<R, W, F> x, Fixed<R, W, F> y, Fixed<R, W, F>
 
 /// Whether length3(x, y, z) >= r, exactly, without the square root (for r > 0): length3 rounds
 /// to nearest with no ties, so it reaches r exactly when the sum of squares N of the raw values
-/// is at least r^2 - r + 1 (raw units). The sum must fit as in length3 (coordinates within a
-/// quarter of the range).
+/// is at least r^2 - r + 1 (raw units). Any raw values fit: three squares below 2^126 each (Fx32)
+/// sum below 2^128.
 template <class R, class W, int F>
 inline bool length3AtLeast(Fixed<R, W, F> x, Fixed<R, W, F> y, Fixed<R, W, F> z, Fixed<R, W, F> r) noexcept {
   using U = detail::RadicandOf<W>;
