@@ -39,13 +39,12 @@ BENCHMARK(BM_BodyGrass)->Apply(arguments);
 
 namespace {
 
-// 1,000 bodies on the thesis meadow (issue 15): 1,000 spheres of radius_cm (20: under the
-// tuft tips, which stand 1 m up; 50: pressing the grass down) on a 32 x 32 grid 1.1 m
-// apart (all over the grass: the meadow is 37.75 m across), body-body broad phase "sap"; `rolling` 1: rolling at (2, 0,
-// 1) m/s (all awake, the contact solver runs for each), 0: at rest (asleep after half a second of warm-up; they still
-// push the grass under them). The grass stage visits only the parts over each row (O(candidate
-// particles), not O(rows x bodies)). Counters: meadow_ms (the same meadow without bodies, timed
-// in the same run, interleaved tick by tick) and ratio_to_meadow.
+// 1,000 bodies on the thesis meadow (issue 15): 1,000 spheres (box 1: cubes of that half-size) of radius_cm (20: under
+// the tuft tips, which stand 1 m up; 50: pressing the grass down) on a 32 x 32 grid 1.1 m apart (all over the grass:
+// the meadow is 37.75 m across), body-body broad phase "sap"; `rolling` 1: rolling at (2, 0, 1) m/s (all awake, the
+// contact solver runs for each), 0: at rest (asleep after half a second of warm-up; they still push the grass under
+// them). The grass stage visits only the parts over each row (O(candidate particles), not O(rows x bodies)). Counters:
+// meadow_ms (the same meadow without bodies, timed in the same run, interleaved tick by tick) and ratio_to_meadow.
 void BM_ThousandBodies(benchmark::State& state) {
   const bool rolling = state.range(1) == 1;
   sg::Scenario s = sg::parseScenario(sg::defaultScenarioText(), "<built-in>", {});
@@ -55,6 +54,11 @@ void BM_ThousandBodies(benchmark::State& state) {
     const std::string name = "ball" + std::to_string(k);
     sg::BodySpec b = sg::bench::rollingSphere("ball", state.range(2), 0, 0);
     b.name = name;
+    if (state.range(3) == 1) {  // a cube of the same half-size instead
+      b.parts[0].type = sg::ShapeType::Box;
+      const sg::Rational half{state.range(2), 100};
+      b.parts[0].halfExtents = {half, half, half};
+    }
     b.position[0] = sg::Rational{110 * (k % 32) - 1705, 100};  // m: -17.05 .. 17.05
     b.position[2] = sg::Rational{110 * (k / 32) - 1705, 100};
     if (!rolling) b.velocity = {sg::Rational{0, 1}, sg::Rational{0, 1}, sg::Rational{0, 1}};
@@ -87,13 +91,15 @@ void BM_ThousandBodies(benchmark::State& state) {
   state.counters["bodies"] = double(world->counts().bodies);
 }
 BENCHMARK(BM_ThousandBodies)
-    ->Args({1, 0, 20})
-    ->Args({2, 0, 20})
-    ->Args({1, 1, 20})
-    ->Args({2, 1, 20})
-    ->Args({1, 0, 50})
-    ->Args({1, 1, 50})
-    ->ArgNames({"threads", "rolling", "radius_cm"})
+    ->Args({1, 0, 20, 0})
+    ->Args({2, 0, 20, 0})
+    ->Args({1, 1, 20, 0})
+    ->Args({2, 1, 20, 0})
+    ->Args({1, 0, 50, 0})
+    ->Args({1, 1, 50, 0})
+    ->Args({1, 0, 20, 1})
+    ->Args({1, 0, 50, 1})
+    ->ArgNames({"threads", "rolling", "radius_cm", "box"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
