@@ -98,10 +98,9 @@ bool pushOut(ParticleArrays<S>& pa, size_t i, const GrassPusher<S>& pusher, BoxP
   if (shape.type == ShapeType::Sphere) {
     const Vec3<S> d = p - pose.position;
     // Most candidates inside the reach cube rest on the ball's surface, just outside it: decided
-    // without the square root (the same answer as comparing length3 below).
+    // without the square root, exactly as length3 >= radius would (so dist < radius below).
     if (length3AtLeast(d.x(), d.y(), d.z(), shape.radius)) return false;
     const S dist = length3(d.x(), d.y(), d.z());
-    if (dist >= shape.radius) return false;
     const Vec3<S> n = dist == S(0) ? Vec3<S>(Vec3<S>::UnitY()) : Vec3<S>(d / dist);
     const Vec3<S> moved = p + n * ((shape.radius - dist) * pusher.share);
     pa.px[i] = moved.x();
