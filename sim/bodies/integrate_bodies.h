@@ -35,7 +35,8 @@ inline void clampAngularSpeed(std::vector<RigidBody<S>>& bodies, S maxAngularSpe
   }
 }
 
-/// p += v h; q += h/2 (0, w) q, renormalised (h: one sub-step, s).
+/// p += v h; q += h/2 (0, w) q, renormalised (h: one sub-step, s). Updates the rotation matrix;
+/// the world inverse inertia is left to the caller (RigidBody::updateInvInertiaWorld, once a tick).
 template <class S>
 inline void integrateBodyPositions(std::vector<RigidBody<S>>& bodies, S h) {
   for (RigidBody<S>& b : bodies) {
@@ -46,7 +47,7 @@ inline void integrateBodyPositions(std::vector<RigidBody<S>>& bodies, S h) {
     Quat<S> q = b.orientation;
     q.coeffs() += (spin * b.orientation).coeffs();
     b.orientation = normalizedQuat(q);
-    b.updateDerived();
+    b.updateRotation();
   }
 }
 

@@ -55,9 +55,13 @@ struct RigidBody {
 
   /// Rotation matrix and world inverse inertia R diag(I^-1) R^T from the orientation.
   void updateDerived() {
-    rotation = orientation.toRotationMatrix();
-    invInertiaWorld = rotation * invInertiaLocal.asDiagonal() * rotation.transpose();
+    updateRotation();
+    updateInvInertiaWorld();
   }
+  /// The rotation matrix alone (each sub-step: the contact anchors and the gyroscopic term read it).
+  void updateRotation() { rotation = orientation.toRotationMatrix(); }
+  /// R diag(I^-1) R^T from `rotation` (read only when contacts are prepared, once a tick).
+  void updateInvInertiaWorld() { invInertiaWorld = rotation * invInertiaLocal.asDiagonal() * rotation.transpose(); }
   Pose<S> partPose(size_t i) const {
     // A part at the centre of mass (every single-part body) skips the rotation: R 0 is exactly 0.
     if (parts[i].offset == Vec3<S>::Zero()) return Pose<S>{position, rotation};

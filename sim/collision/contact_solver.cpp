@@ -252,12 +252,18 @@ void warmStartContacts(std::vector<RigidBody<S>>& bodies, const std::vector<Cont
 }
 
 template <class S>
+void updateSeparations(const std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows) {
+  // The anchors moved with their bodies since prepare.
+  for (ContactRow<S>& row : rows)
+    row.separationNow = row.separation + (anchorDifference(bodies, row) - row.anchorGap).dot(row.normal.dir);
+}
+
+template <class S>
 void solveContacts(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows,
                    const SolverSettings<S>& settings, bool useBias) {
   for (ContactRow<S>& row : rows) {
     ContactAxis<S>& n = row.normal;
-    // The separation now: the anchors moved with their bodies since prepare.
-    const S s = row.separation + (anchorDifference(bodies, row) - row.anchorGap).dot(n.dir);
+    const S s = row.separationNow;
     S bias(0), massScale(1), impulseScale(0);
     if (s > S(0)) {
       // Speculative: close at most the gap in this sub-step. Only in the solve, which the
@@ -421,6 +427,7 @@ void storeImpulses(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<
   template void prepareContacts(const std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&,                    \
                                 const std::vector<CachedImpulse<S>>&, std::vector<ContactRow<S>>&);                  \
   template void warmStartContacts(std::vector<RigidBody<S>>&, const std::vector<ContactRow<S>>&);                    \
+  template void updateSeparations(const std::vector<RigidBody<S>>&, std::vector<ContactRow<S>>&);                    \
   template void solveContacts(std::vector<RigidBody<S>>&, std::vector<ContactRow<S>>&, const SolverSettings<S>&,     \
                               bool);                                                                                 \
   template void applyRestitution(std::vector<RigidBody<S>>&, std::vector<ContactRow<S>>&, const SolverSettings<S>&); \

@@ -26,8 +26,9 @@
 //   * Sub-steps: the stack and mass-ratio error of Gauss-Seidel falls with the step size
 //     squared, so 4 sub-steps of 1 iteration beat 16 iterations of one step (Box2D's result:
 //     a 20-box stack stands at defaults, where the old solver needed 128 iterations).
-//   * The current separation is recomputed from the bodies' moved anchors in every iteration, so
-//     a sub-step solves the positions it has, not those of the tick's start.
+//   * The current separation is recomputed from the bodies' moved anchors after every position
+//     update (before the solve and before the relax sweeps), so a sub-step solves the positions it
+//     has, not those of the tick's start.
 //   * Speculative contacts: a contact of positive separation s (the narrow phase reports shapes
 //     up to the speculative distance plus the tick's motion apart) lets the bodies close by at
 //     most s within a sub-step (bias s / h). A body fast enough to pass through a wall in one
@@ -111,6 +112,7 @@ struct ContactRow {
           localB = Vec3<S>::Zero();     ///< m: contact point from each centre of mass, body frame
   Vec3<S> anchorGap = Vec3<S>::Zero();  ///< m: A's anchor - B's anchor (terrain: A's alone) at prepare; s starts exact
   S separation{};                       ///< m at prepare: minus the penetration (> 0: speculative)
+  S separationNow{};                    ///< m: the separation at the bodies' present poses (updateSeparations)
   S invMassA{}, invMassB{};
   S impactVelocity{};  ///< m/s: the most negative normal velocity a pushing solve met this tick
   S impactGap{};       ///< m: the separation (>= 0) when it did (a speculative stop short of the surface)
@@ -132,9 +134,14 @@ void prepareContacts(const std::vector<RigidBody<S>>& bodies, const std::vector<
 template <class S>
 void warmStartContacts(std::vector<RigidBody<S>>& bodies, const std::vector<ContactRow<S>>& rows);
 
-/// One sweep over all rows: the normal (soft when `useBias`; speculative rows always limit the
-/// approach to their current gap per sub-step), then Coulomb friction on two tangents within
-/// mu x normal impulse.
+/// Sets every row's separationNow from its bodies' present poses: once before the solve sweeps
+/// and once before the relax sweeps of a sub-step, the only places the poses have moved (the
+/// sweeps change velocities only), instead of once per row in every sweep.
+template <class S>
+void updateSeparations(const std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows);
+
+/// One sweep over all rows (after updateSeparations): the normal (soft when `useBias`; speculative rows always limit
+/// the approach to their current gap per sub-step), then Coulomb friction on two tangents within mu x normal impulse.
 template <class S>
 void solveContacts(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows,
                    const SolverSettings<S>& settings, bool useBias);

@@ -88,10 +88,16 @@ bool World<S>::respondToContacts() {
     clampAngularSpeed(bodies_, maxAngularSpeed_);
     applyGyroscopicTerm(bodies_, substepDt_);
     warmStartContacts(bodies_, contactRows_);
+    updateSeparations(bodies_, contactRows_);
     for (int it = 0; it < solver_.solveIterations; ++it) solveContacts(bodies_, contactRows_, solver_, true);
     integrateBodyPositions(bodies_, substepDt_);
+    updateSeparations(bodies_, contactRows_);
     for (int it = 0; it < solver_.relaxIterations; ++it) solveContacts(bodies_, contactRows_, solver_, false);
   }
+  // The sub-steps turned the awake bodies' rotations only; their world inverse inertia is read at
+  // the next prepare (contact Jacobians), so it is computed once here, not in every sub-step.
+  for (RigidBody<S>& b : bodies_)
+    if (!b.asleep) b.updateInvInertiaWorld();
   // Stored before restitution: the next tick warm-starts with the sub-step's resting impulse, not
   // with the one-off bounce (re-applied, it held a bounced ball on the ground for a tick).
   storeImpulses(bodies_, contacts_, contactRows_, solver_, impulseCache_);
