@@ -395,6 +395,27 @@ TEST(SoftStep, ColumnInsideTheRuleStandsFx16) { expectColumnInsideTheRuleStands<
 TEST(SoftStep, ColumnInsideTheRuleStandsDouble) { expectColumnInsideTheRuleStands<double>("double"); }
 
 template <class S>
+void expectFortyCubeColumnSleeps(const char* name) {
+  // 40 cubes of 1 m at the defaults (inside the rule: a = 0.5 m >= 2 x 40^2 / 60^2 = 0.89 m? no:
+  // the rule's a is the half-width, 0.5 m, short of it; the column still stands, see the docs'
+  // table). The bottom joint carries 39 cubes and gives 2 x 39 g / omega^2 = 5.4 mm, past the 5 mm
+  // slop: counted as a push-out, the column never slept and walked over (0.2 to 0.7 m in 10 s).
+  // The give under a contact's own load is now where it rests, so the column settles and sleeps.
+  const Drift r = columnWith<S>(40, 500, 4, 60);
+  std::printf("[column of 40 x 1 m %s] drift %.4f m, sink %.4f m, %s\n", name, r.horizontal, r.sink,
+              r.allAsleep ? "asleep" : "awake");
+  EXPECT_TRUE(r.allAsleep) << name;
+  EXPECT_LT(r.horizontal, 0.1) << name;  // a fifth of the half-width (measured 3.5 and 5.5 cm)
+  // The joints give sum_k 2 k g / omega^2 = n (n - 1) g / omega^2 = 11 cm in all, plus 4 cm of
+  // placement gaps; measured 21 cm (the sweeps do not fully carry the load down the column).
+  const double omega = 2 * std::numbers::pi * 60;
+  EXPECT_LT(r.sink, 40 * 0.001 + 2 * 40 * 39 * 9.81 / (omega * omega)) << name;
+}
+// fx16 is left out: its 40-cube column still sways off (0.74 m, awake; docs/physics-notes.md).
+TEST(SoftStep, FortyCubeColumnSleepsFx32) { expectFortyCubeColumnSleeps<Fx32>("fx32"); }
+TEST(SoftStep, FortyCubeColumnSleepsDouble) { expectFortyCubeColumnSleeps<double>("double"); }
+
+template <class S>
 void expectColumnBeyondTheRuleFalls(const char* name) {
   // The same 20 cubes of 10 cm at the defaults (4 sub-steps, 60 Hz: the rule wants 126 Hz) lean
   // over and fall in under 3 s, in every scalar (1.6 to 2.0 m). This holds the documented limit:

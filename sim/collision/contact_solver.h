@@ -62,12 +62,16 @@ Softness<S> makeSoftness(S hertz, S zeta, S h, S pi);
 
 template <class S>
 struct SolverSettings {
-  int substeps = 4;                   ///< sub-steps per tick (the scenario's bodies.substeps)
-  int solveIterations = 3;            ///< solve sweeps per sub-step (bodies.velocityIterations)
-  int relaxIterations = 1;            ///< relax sweeps per sub-step (bodies.positionIterations)
-  S restitutionThreshold{};           ///< m/s
-  S maxPushVelocity{};                ///< m/s: the fastest a soft contact pushes overlap out
-  S linearSlop{};                     ///< m: deeper overlap keeps a body awake (settings::kLinearSlop)
+  int substeps = 4;          ///< sub-steps per tick (the scenario's bodies.substeps)
+  int solveIterations = 3;   ///< solve sweeps per sub-step (bodies.velocityIterations)
+  int relaxIterations = 1;   ///< relax sweeps per sub-step (bodies.positionIterations)
+  S restitutionThreshold{};  ///< m/s
+  S maxPushVelocity{};       ///< m/s: the fastest a soft contact pushes overlap out
+  S linearSlop{};            ///< m: deeper overlap keeps a body awake (settings::kLinearSlop)
+  /// s: 1 / (h omega^2) of body-body and terrain contacts. A soft contact carrying the normal
+  /// impulse P per sub-step gives way by P / (m h omega^2), m its effective mass, at rest: that
+  /// much overlap is its load, not a push-out (storeImpulses' sleep rule).
+  S bodyGiveTime{}, staticGiveTime{};
   S invSubstep{};                     ///< 1/s: 1 / h
   Vec3<S> gravity = Vec3<S>::Zero();  ///< m/s^2 (restitution's speculative-gap gain)
   Softness<S> bodySoftness;           ///< body against body

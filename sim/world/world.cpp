@@ -142,6 +142,10 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
     const S zeta = toS<S>(exact(settings::kContactDampingRatio)), pi = toS<S>(exact(settings::kPi));
     solver_.bodySoftness = makeSoftness(hertz, zeta, substepDt_, pi);
     solver_.staticSoftness = makeSoftness(S(2) * hertz, zeta, substepDt_, pi);
+    // (1 / h) / omega / omega: omega^2 itself leaves fx16's range above 28 Hz.
+    const S omega = S(2) * pi * hertz;
+    solver_.bodyGiveTime = hertz > S(0) ? S(S(solver_.invSubstep / omega) / omega) : S(0);
+    solver_.staticGiveTime = solver_.bodyGiveTime / S(4);  // twice the frequency
   }
   // A quarter turn per sub-step (Box2D v3's b2_maxRotation): (pi / 4) x substeps / dt, exact
   // before the one rounding (188 rad/s at the defaults).
