@@ -21,14 +21,15 @@ Vec3<S> tangentOf(const Vec3<S>& n) {
 /// the projection scales that pair, so with fixed axes 45 deg to the slide a box slid 1.5 % too
 /// far and drifted 1.6 cm sideways in a metre. Slower contacts (resting ones) keep the fixed
 /// axes, so warm-started static friction does not turn with rounding noise. 1 cm/s: 655 units
-/// of fx16, a clean direction.
+/// of fx16, a clean direction. A slide must also outrun a tick of its kinetic friction
+/// (turnSlidingPairs) before its axes turn.
 template <class S>
 S slidingAxisSpeed() {
   return S(1) / S(100);
 }
 
 /// The first friction axis of a contact: along the tangential part of A's velocity against B's
-/// (or the ground's) when that slides (*sliding = true), else tangentOf(n). The centres'
+/// (or the ground's) when that slides (*sliding = true, *slideSpeed its speed), else tangentOf(n). The centres'
 /// velocities, not the contact points': every contact of a pair then turns its axes on the same
 /// tick and the same way (per point, corners crossing the speed on different ticks mixed axes
 /// and set a sliding box spinning). Only while the bodies' turning moves their surfaces less
@@ -36,7 +37,8 @@ S slidingAxisSpeed() {
 /// corners slip across its drift, and with t1 along the drift first they got the whole cone the
 /// wrong way (a 10 rad/s box drifting at 2 cm/s lost its spin 0.65 times as fast as it should).
 template <class S>
-Vec3<S> frictionDirection(const Vec3<S>& n, const RigidBody<S>& A, const RigidBody<S>* B, bool* sliding) {
+Vec3<S> frictionDirection(const Vec3<S>& n, const RigidBody<S>& A, const RigidBody<S>* B, bool* sliding,
+                          S* slideSpeed) {
   Vec3<S> v = A.velocity;
   if (B) v -= B->velocity;
   const Vec3<S> tangential = v - n * n.dot(v);
@@ -49,6 +51,7 @@ Vec3<S> frictionDirection(const Vec3<S>& n, const RigidBody<S>& A, const RigidBo
   if (B) turning += length3(B->angularVelocity.x(), B->angularVelocity.y(), B->angularVelocity.z()) * B->boundingRadius;
   if (!(turning + turning < length)) return tangentOf(n);
   *sliding = true;
+  *slideSpeed = length;
   return tangential / length;
 }
 
@@ -190,11 +193,44 @@ void matchCachedImpulses(const std::vector<Contact<S>>& contacts, const std::vec
     rows[i].normal.impulse = hit.normal;
     rows[i].t1.impulse = hit.tangent1;
     rows[i].t2.impulse = hit.tangent2;
-    if (rows[i].slidingAxes) {  // the cache holds the fixed axes' impulses: turn them onto the sliding axes
-      const Vec3<S> fixed1 = tangentOf(rows[i].normal.dir);
-      turnFriction(fixed1, Vec3<S>(rows[i].normal.dir.cross(fixed1)), hit.tangent1, hit.tangent2, rows[i].t1.dir,
-                   rows[i].t2.dir, &rows[i].t1.impulse, &rows[i].t2.impulse);
+  }
+}
+
+/// Turns the rows of each body pair whose centres slide past each other onto sliding axes (t1
+/// along the slide, frictionDirection), but only where the slide outruns what a tick of the
+/// pair's kinetic friction can take off it: mu x the pair's warm-started normal impulses x
+/// (1/mA + 1/mB) x substeps (m/s). Slower, the axis fixed for the tick overshoots: friction along
+/// a slide direction with a small sideways part took more than that sideways speed off in one
+/// tick and reversed it, x(1 - mu g cos dt / v) per tick. A box 0.25 deg past its friction angle on
+/// a 27 deg slope switched at 1 cm/s, its sideways speed grew 4-fold a tick, and friction along
+/// the swinging axis let it gain 4 cm/s in four ticks (a slide 27 % too long; 44 % at 45 deg).
+template <class S>
+void turnSlidingPairs(const std::vector<uint8_t>& slides, const std::vector<S>& slideSpeed,
+                      const std::vector<Vec3<S>>& slideDir, const std::vector<RigidBody<S>>& bodies,
+                      const std::vector<Contact<S>>& contacts, int substeps, std::vector<ContactRow<S>>& rows) {
+  for (size_t first = 0; first < rows.size();) {
+    size_t last = first;
+    S capacity(0);  // m/s per sub-step, then per tick
+    for (; last < rows.size() && rows[last].a == rows[first].a && rows[last].b == rows[first].b; ++last)
+      capacity += rows[last].friction * rows[last].normal.impulse * (rows[last].invMassA + rows[last].invMassB);
+    capacity *= S(substeps);
+    for (size_t i = first; i < last; ++i) {
+      ContactRow<S>& row = rows[i];
+      if (!slides[i] || !(slideSpeed[i] > capacity)) continue;
+      const RigidBody<S>& A = bodies[size_t(row.a)];
+      const RigidBody<S>* B = row.b == kTerrainBody ? nullptr : &bodies[size_t(row.b)];
+      const Vec3<S> rA = contacts[i].point - A.position;
+      const Vec3<S> rB = B ? Vec3<S>(contacts[i].point - B->position) : Vec3<S>(Vec3<S>::Zero());
+      const Vec3<S>& n = row.normal.dir;
+      const S fixed1 = row.t1.impulse, fixed2 = row.t2.impulse;
+      const Vec3<S> fixedDir1 = row.t1.dir, fixedDir2 = row.t2.dir;
+      row.t1 = makeAxis(slideDir[i], A, rA, B, rB);
+      row.t2 = makeAxis(Vec3<S>(n.cross(slideDir[i])), A, rA, B, rB);
+      // The cache holds the fixed axes' impulses: turn them onto the sliding axes.
+      turnFriction(fixedDir1, fixedDir2, fixed1, fixed2, row.t1.dir, row.t2.dir, &row.t1.impulse, &row.t2.impulse);
+      row.slidingAxes = true;
     }
+    first = last;
   }
 }
 
@@ -213,9 +249,12 @@ Vec3<S> anchorDifference(const std::vector<RigidBody<S>>& bodies, const ContactR
 
 template <class S>
 void prepareContacts(const std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
-                     const std::vector<CachedImpulse<S>>& cache, std::vector<ContactRow<S>>& rows) {
+                     const std::vector<CachedImpulse<S>>& cache, int substeps, std::vector<ContactRow<S>>& rows) {
   using std::sqrt;
   rows.assign(contacts.size(), ContactRow<S>{});
+  std::vector<uint8_t> slides(contacts.size(), 0);
+  std::vector<S> slideSpeed(contacts.size(), S(0));
+  std::vector<Vec3<S>> slideDir(contacts.size(), Vec3<S>::Zero());
   for (size_t i = 0; i < contacts.size(); ++i) {
     const Contact<S>& c = contacts[i];
     ContactRow<S>& row = rows[i];
@@ -227,7 +266,10 @@ void prepareContacts(const std::vector<RigidBody<S>>& bodies, const std::vector<
     const Vec3<S> rB = B ? Vec3<S>(c.point - B->position) : Vec3<S>(Vec3<S>::Zero());
     row.localA = A.rotation.transpose() * rA;
     if (B) row.localB = B->rotation.transpose() * rB;
-    const Vec3<S> t1 = frictionDirection(c.normal, A, B, &row.slidingAxes);
+    bool sliding = false;
+    slideDir[i] = frictionDirection(c.normal, A, B, &sliding, &slideSpeed[i]);
+    slides[i] = sliding ? 1 : 0;
+    const Vec3<S> t1 = tangentOf(c.normal);  // fixed axes; turnSlidingPairs turns sliding pairs
     row.normal = makeAxis(c.normal, A, rA, B, rB);
     row.t1 = makeAxis(t1, A, rA, B, rB);
     row.t2 = makeAxis(Vec3<S>(c.normal.cross(t1)), A, rA, B, rB);
@@ -243,6 +285,7 @@ void prepareContacts(const std::vector<RigidBody<S>>& bodies, const std::vector<
     row.anchorGap = anchorDifference(bodies, row);  // the separation's reference: s is exact at prepare
   }
   matchCachedImpulses(contacts, cache, rows);
+  turnSlidingPairs(slides, slideSpeed, slideDir, bodies, contacts, substeps, rows);
 }
 
 template <class S>
@@ -432,7 +475,7 @@ void storeImpulses(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<
   template Softness<S> makeSoftness(S, S, S, S);                                                                     \
   template void sortContacts(std::vector<Contact<S>>&);                                                              \
   template void prepareContacts(const std::vector<RigidBody<S>>&, const std::vector<Contact<S>>&,                    \
-                                const std::vector<CachedImpulse<S>>&, std::vector<ContactRow<S>>&);                  \
+                                const std::vector<CachedImpulse<S>>&, int, std::vector<ContactRow<S>>&);             \
   template void warmStartContacts(std::vector<RigidBody<S>>&, const std::vector<ContactRow<S>>&);                    \
   template void updateSeparations(const std::vector<RigidBody<S>>&, std::vector<ContactRow<S>>&);                    \
   template void solveContacts(std::vector<RigidBody<S>>&, std::vector<ContactRow<S>>&, const SolverSettings<S>&,     \

@@ -132,7 +132,7 @@ struct ContactRow {
 /// swap clipping features from tick to tick, and losing their impulses makes a stack walk).
 template <class S>
 void prepareContacts(const std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
-                     const std::vector<CachedImpulse<S>>& cache, std::vector<ContactRow<S>>& rows);
+                     const std::vector<CachedImpulse<S>>& cache, int substeps, std::vector<ContactRow<S>>& rows);
 
 /// Applies every row's accumulated impulses (the start of each sub-step).
 template <class S>

@@ -82,7 +82,8 @@ bool World<S>::bodiesFaulted(Stage stage) {
 
 template <class S>
 bool World<S>::respondToContacts() {
-  prepareContacts(bodies_, contacts_, impulseCache_, contactRows_);  // before gravity: the approach velocities
+  prepareContacts(bodies_, contacts_, impulseCache_, solver_.substeps,
+                  contactRows_);  // before gravity: the approach velocities
   for (int sub = 0; sub < solver_.substeps; ++sub) {
     applyGravity(bodies_, gravitySubstep_);
     clampAngularSpeed(bodies_, maxAngularSpeed_);
