@@ -365,11 +365,11 @@ TEST(ScenarioDerived, AReachOutOfRangeIsReportedAtItsLargestTerm) {
   // A blade top is terrain height + constraintLength + scaleY: the key named is the one that is
   // out of scale, not always the terrain's.
   auto build = [](const std::string& text) { return [text] { makeWorld(parse(text)); }; };
-  EXPECT_TRUE(throwsError(build(R"({"scalar": "double", "particles": {"constraintLength": 1e15}})"),
+  EXPECT_TRUE(throwsError(build(R"({"scalar": "double", "particles": {"constraintLength": 1e14}})"),
                           "$.particles.constraintLength", "a blade top"));
   EXPECT_TRUE(
-      throwsError(build(R"({"scalar": "double", "field": {"scaleY": 1e15}})"), "$.field.scaleY", "a blade top"));
-  EXPECT_TRUE(throwsError(build(R"({"scalar": "double", "terrain": {"type": "flat", "height": 1e15}})"),
+      throwsError(build(R"({"scalar": "double", "field": {"scaleY": 1e14}})"), "$.field.scaleY", "a blade top"));
+  EXPECT_TRUE(throwsError(build(R"({"scalar": "double", "terrain": {"type": "flat", "height": 1e14}})"),
                           "$.terrain.height", "a blade top"));
   // A field or heightmap extent: the centre when it is the larger term, else what sets the size.
   EXPECT_TRUE(

@@ -3,6 +3,8 @@
 // tick) and the response (the soft step of sim/collision/contact_solver.h: sub-steps of gravity,
 // the gyroscopic term, warm start, solve, position integration and relax; then restitution and
 // damping; then mowing, and the grass pushed out of every body, with optional grass drag).
+#include <cmath>
+
 #include "sim/bodies/gyroscopic.h"
 #include "sim/bodies/integrate_bodies.h"
 #include "sim/collision/body_pairs.h"
@@ -63,18 +65,40 @@ template <class S>
 bool World<S>::bodiesFaulted(Stage stage) {
   using T = ScalarTraits<S>;
   const uint32_t faults = takeFixedFaults();
+  // Float and double: finite and within the range a saved state may hold (maxStateMagnitude),
+  // so that every state a run reaches can be recorded and read back. Fixed point: its faults.
+  auto inRange = [](S v) {
+    if constexpr (T::isFixed) {
+      return true;
+    } else {
+      return T::isFinite(v) && !(std::fabs(double(v)) > T::maxStateMagnitude);
+    }
+  };
   for (size_t i = 0; i < bodies_.size(); ++i) {
     const RigidBody<S>& b = bodies_[i];
-    bool finite = true;
+    bool ok = true;
     for (int k = 0; k < 3; ++k)
-      finite = finite && T::isFinite(b.position[k]) && T::isFinite(b.velocity[k]) && T::isFinite(b.angularVelocity[k]);
-    if (faults == 0 && finite) continue;
+      ok = ok && inRange(b.position[k]) && inRange(b.velocity[k]) && inRange(b.angularVelocity[k]);
+    if (faults == 0 && ok) continue;
     failed_ = true;
     failure_ = SimError{};
     failure_.tick = tick_;
     failure_.stage = stage;
     failure_.body = int32_t(i);
-    failure_.what = faults ? fixedFaultName(faults) : "non-finite value";
+    failure_.what =
+        faults ? fixedFaultName(faults) : "a value that is not finite or beyond +-2^48 (a saved state's range)";
+    return true;
+  }
+  for (const CachedImpulse<S>& c : impulseCache_) {
+    bool ok = inRange(c.normal) && inRange(c.tangent1) && inRange(c.tangent2);
+    for (int k = 0; k < 3; ++k) ok = ok && inRange(c.point[k]);
+    if (ok) continue;
+    failed_ = true;
+    failure_ = SimError{};
+    failure_.tick = tick_;
+    failure_.stage = stage;
+    failure_.body = c.bodyA;
+    failure_.what = "a contact impulse beyond +-2^48 (a saved state's range)";
     return true;
   }
   return false;

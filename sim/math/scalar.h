@@ -55,7 +55,14 @@ template <class F, ScalarKind K, class B>
 struct FloatTraits {
   static constexpr ScalarKind kind = K;
   static constexpr bool isFixed = false;
-  static constexpr double maxCoordinate = 1e15;
+  /// Largest magnitude a float or double state may hold (m, m/s, rad/s, N s), saved or stepped:
+  /// 2^48, small enough that a step's integer cell lookups (floorToInt of a position over a
+  /// spacing) cannot overflow int64. The world faults a body that leaves it (World::bodiesFaulted)
+  /// and a saved state beyond it is refused, so every state a run reaches can be saved and read.
+  static constexpr double maxStateMagnitude = 281474976710656.0;  // 2^48
+  /// Largest value a scenario may give: 1e14, below maxStateMagnitude with room for motion (a
+  /// body loaded at 5e14 m, inside the former 1e15, recorded a state no replay could read).
+  static constexpr double maxCoordinate = 1e14;
   static std::optional<F> fromRational(const Rational& r) { return F(r.toDouble()); }
   static double toDouble(F v) { return double(v); }
   static bool faultPending() { return false; }

@@ -19,11 +19,6 @@ void putSection(StateSink& sink, Section section, uint64_t payloadBytes) {
   sink.put(payloadBytes);
 }
 
-/// The largest magnitude a float or double state may hold (m, m/s, rad/s, N s): 2^48, far past
-/// any world that can be saved (fx32's whole range is 2^31), and small enough that the next
-/// step's integer cell lookups (floorToInt of a position over a spacing) cannot overflow int64.
-constexpr double kMaxFloatStateMagnitude = 281474976710656.0;  // 2^48
-
 /// Float and double states: n values at the cursor, each finite and within +-2^48 (a NaN or a
 /// 1e45 in a restored state would reach the step as undefined behaviour, not as a fault). Fixed
 /// states need no check: every raw value is a value of the type. Reads a copy of the cursor.
@@ -33,7 +28,7 @@ void checkFloatValues(state::Cursor at, uint64_t n, const char* what) {
     for (uint64_t i = 0; i < n; ++i) {
       const uint64_t offset = at.offset();
       const double v = double(at.read<S>(what));
-      if (!(v >= -kMaxFloatStateMagnitude && v <= kMaxFloatStateMagnitude))
+      if (!(v >= -ScalarTraits<S>::maxStateMagnitude && v <= ScalarTraits<S>::maxStateMagnitude))
         throw StateError(offset, std::string("a finite ") + what + " within +-2^48");
     }
   }
