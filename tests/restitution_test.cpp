@@ -82,6 +82,56 @@ TEST(Restitution, ElasticBallKeepsItsHeightForAMinuteFx32) { expectElasticBallKe
 TEST(Restitution, ElasticBallKeepsItsHeightForAMinuteFx16) { expectElasticBallKeepsItsHeight<Fx16>("fx16"); }
 TEST(Restitution, ElasticBallKeepsItsHeightForAMinuteDouble) { expectElasticBallKeepsItsHeight<double>("double"); }
 
+// ---- an elastic ball on a resting body -----------------------------------------------------------
+// The same ball dropped 2 m onto a 1000 kg slab (2 x 1 x 2 m) resting on the ground. A speculative
+// push stops the ball short of the slab, and the restitution pass added gravity's gain over that
+// gap only against the terrain ("between two bodies gravity pulls both alike"); but the slab is
+// held up by the ground, so the pair's relative pull is g, and the ball lost 31 % of its height in
+// a minute (found by review). The gain now counts each body's gravity unless a contact holds it.
+template <class S>
+void expectElasticBallKeepsItsHeightOnASlab(const char* name) {
+  Scenario s = emptyWorld();
+  BodySpec slab;
+  slab.name = "slab";
+  ShapeSpec part;
+  part.type = ShapeType::Box;
+  part.halfExtents = {Rational{1, 1}, Rational{1, 2}, Rational{1, 1}};
+  slab.parts = {part};
+  slab.position = r3(0, 5, 0, 10);  // resting on the ground
+  slab.mass = Rational{1000, 1};
+  slab.restitution = Rational{1, 1};
+  slab.friction = Rational{0, 1};
+  s.bodies.list = {slab, sphere("ball", Rational{1, 10}, r3(0, 31, 0, 10))};  // 2 m above the slab
+  s.bodies.list[1].restitution = Rational{1, 1};
+  s.bodies.list[1].friction = Rational{0, 1};
+  s.bodies.list[1].canSleep = false;
+  auto w = makeTyped<S>(s);
+  std::vector<double> apex;
+  double prevV = 0;
+  for (int64_t t = 0; t < 60 * 60; ++t) {
+    ASSERT_TRUE(w->step(TickInput{}).ok) << name << " tick " << t;
+    const auto& b = w->bodies()[1];
+    const double v = ScalarTraits<S>::toDouble(b.velocity.y());
+    if (prevV > 0 && v <= 0) apex.push_back(ScalarTraits<S>::toDouble(b.position.y()) - 1.1);
+    prevV = v;
+  }
+  ASSERT_GE(apex.size(), 40u) << name;
+  double lo = apex[0], hi = apex[0];
+  for (double a : apex) lo = std::min(lo, a), hi = std::max(hi, a);
+  std::printf("[elastic ball on a slab %s] %zu apexes in 60 s, %.4f to %.4f m (free-slab bound %.4f m)\n", name,
+              apex.size(), lo, hi, kDrop * std::pow(999.0 / 1001.0, 2.0 * double(apex.size())));
+  // Never higher than the drop (+1 %). Never lower than if the slab were free: an elastic impact
+  // of m = 1 kg on M = 1000 kg returns ((M - m) / (M + m))^2 of the ball's energy, the rest going
+  // into the slab, whose slow push into the ground (1.3 cm/s, below the 1 m/s bounce threshold)
+  // does not come back. The ground holding the slab during the solve keeps more than that.
+  EXPECT_LT(hi, kDrop * 1.01) << name;
+  for (size_t k = 0; k < apex.size(); ++k)
+    EXPECT_GT(apex[k], 0.99 * kDrop * std::pow(999.0 / 1001.0, 2.0 * double(k + 1))) << name << " apex " << k;
+}
+TEST(Restitution, ElasticBallKeepsItsHeightOnASlabFx32) { expectElasticBallKeepsItsHeightOnASlab<Fx32>("fx32"); }
+TEST(Restitution, ElasticBallKeepsItsHeightOnASlabFx16) { expectElasticBallKeepsItsHeightOnASlab<Fx16>("fx16"); }
+TEST(Restitution, ElasticBallKeepsItsHeightOnASlabDouble) { expectElasticBallKeepsItsHeightOnASlab<double>("double"); }
+
 /// The analytic sequence: impact speeds u_k = e^k u_0 (u_0 = sqrt(2 g h)); an impact faster than
 /// the 1 m/s restitution threshold bounces (flight 2 e u_k / g), the first slower one ends it.
 struct Analytic {

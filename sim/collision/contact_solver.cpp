@@ -388,21 +388,44 @@ void applyRestitution(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<
                       const SolverSettings<S>& settings) {
   // Against the fastest approach a pushing solve met (before its impulse), and only where the
   // contact pushed (a contact that merely grazed bounces nothing).
-  for (ContactRow<S>& row : rows) {
+  // Which bodies something holds up this tick: a body with a pushing row whose partner is not the
+  // one it bounces on (the ground, or another body) does not fall with gravity over the gap below.
+  // Rows are in canonical order, so a pair's rows are consecutive.
+  std::vector<int32_t> pushingRows(bodies.size(), 0);
+  for (const ContactRow<S>& row : rows) {
+    if (!(row.maxImpulseN > S(0))) continue;
+    ++pushingRows[size_t(row.a)];
+    if (row.b != kTerrainBody) ++pushingRows[size_t(row.b)];
+  }
+  int32_t pairPushing = 0;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    ContactRow<S>& row = rows[i];
+    if (i == 0 || rows[i - 1].a != row.a || rows[i - 1].b != row.b) {
+      pairPushing = 0;
+      for (size_t k = i; k < rows.size() && rows[k].a == row.a && rows[k].b == row.b; ++k)
+        if (rows[k].maxImpulseN > S(0)) ++pairPushing;
+    }
     if (!(row.maxImpulseN > S(0)) || !(row.impactVelocity < -settings.restitutionThreshold)) continue;
     if (row.restitution == S(0)) continue;
     ContactAxis<S>& n = row.normal;
     // A speculative push stopped the body `impactGap` short of where it would have met the
-    // surface (it then rests on it for the rest of the tick): against the terrain, gravity
-    // would have sped it up over that gap, so the impact speed gets the gain of
-    // v^2 = V^2 + 2 g_n gap (first order: V + g_n gap / V; gap <= V h keeps the neglected term
-    // below (g h / V)^2 / 2 of V, 0.08 % at the 1 m/s threshold and 60 Hz x 4). Without it an elastic
-    // ball lost m g_n gap, half a sub-step of fall on average, every bounce (a third of its height
-    // in a minute). Between two bodies gravity pulls both alike: no relative gain.
+    // surface (it then rests on it for the rest of the tick): gravity would have sped the pair's
+    // approach up over that gap, so the impact speed gets the gain of v^2 = V^2 + 2 g_n gap
+    // (first order: V + g_n gap / V; gap <= V h keeps the neglected term below (g h / V)^2 / 2 of
+    // V, 0.08 % at the 1 m/s threshold and 60 Hz x 4). Without it an elastic ball lost m g_n gap,
+    // half a sub-step of fall on average, every bounce (a third of its height in a minute). g_n is
+    // the pair's relative pull: gravity on each body that falls freely, none on the terrain or on
+    // a body another contact holds up. Two free bodies fall alike (no gain); a ball on a slab
+    // resting on the ground gets the whole pull (without it, 31 % of its height in a minute).
     S impactSpeed = -row.impactVelocity;
-    if (row.b == kTerrainBody && row.impactGap > S(0)) {
-      const S pull = -settings.gravity.dot(n.dir);  // m/s^2 towards the surface
-      if (pull > S(0)) impactSpeed += pull * row.impactGap / impactSpeed;
+    if (row.impactGap > S(0)) {
+      const bool heldA = pushingRows[size_t(row.a)] > pairPushing;
+      const bool heldB = row.b == kTerrainBody || pushingRows[size_t(row.b)] > pairPushing;
+      if (heldA != heldB) {
+        // The relative acceleration of A against B along n: +g.n when only A falls, -g.n when only B.
+        const S pull = heldB ? S(-settings.gravity.dot(n.dir)) : settings.gravity.dot(n.dir);  // m/s^2, closing
+        if (pull > S(0)) impactSpeed += pull * row.impactGap / impactSpeed;
+      }
     }
     const S vn = axisVelocity(bodies, row, n);
     const S lambda = -(vn - row.restitution * impactSpeed) * n.mass;
