@@ -91,13 +91,8 @@ TEST(Restitution, ElasticBallKeepsItsHeightForAMinuteDouble) { expectElasticBall
 template <class S>
 void expectElasticBallKeepsItsHeightOnASlab(const char* name) {
   Scenario s = emptyWorld();
-  BodySpec slab;
-  slab.name = "slab";
-  ShapeSpec part;
-  part.type = ShapeType::Box;
-  part.halfExtents = {Rational{1, 1}, Rational{1, 2}, Rational{1, 1}};
-  slab.parts = {part};
-  slab.position = r3(0, 5, 0, 10);  // resting on the ground
+  // resting on the ground
+  BodySpec slab = test::box("slab", {Rational{1, 1}, Rational{1, 2}, Rational{1, 1}}, r3(0, 5, 0, 10));
   slab.mass = Rational{1000, 1};
   slab.restitution = Rational{1, 1};
   slab.friction = Rational{0, 1};

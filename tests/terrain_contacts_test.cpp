@@ -181,13 +181,8 @@ TEST(TerrainContacts, PlanarHeightmapsAreThePlaneDouble) { expectPlanarHeightmap
 
 /// A 0.5 m cube of 1 kg at (0, y, 0), level, restitution 0.
 BodySpec cube(Rational y, Rational friction) {
-  BodySpec box;
-  box.name = "box";
-  ShapeSpec part;
-  part.type = ShapeType::Box;
-  part.halfExtents = {Rational{1, 4}, Rational{1, 4}, Rational{1, 4}};
-  box.parts = {part};
-  box.position = {Rational{0, 1}, y, Rational{0, 1}};
+  BodySpec box =
+      test::box("box", {Rational{1, 4}, Rational{1, 4}, Rational{1, 4}}, {Rational{0, 1}, y, Rational{0, 1}});
   box.restitution = Rational{0, 1};
   box.friction = friction;
   return box;

@@ -76,6 +76,18 @@ inline BodySpec sphere(const char* name, Rational radius, Rational3 position) {
   return b;
 }
 
+/// A box body of the given half extents at a position (defaults for everything else).
+inline BodySpec box(const char* name, Rational3 halfExtents, Rational3 position) {
+  BodySpec b;
+  b.name = name;
+  ShapeSpec p;
+  p.type = ShapeType::Box;
+  p.halfExtents = halfExtents;
+  b.parts = {p};
+  b.position = position;
+  return b;
+}
+
 /// An exact plane rising along +x with slope 1/4: samples 15 x (x = 0..16, 1 m apart, the map
 /// centred at 0) and maxHeight 17/4 m give h = (x + 8) / 4 exactly, i.e. h(0) = 2.
 inline Scenario slope() {
