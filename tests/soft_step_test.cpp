@@ -40,13 +40,7 @@ double d(S v) {
 Rational mm(int64_t v) { return *Rational::make(v, 1000); }
 
 BodySpec box(const std::string& name, Rational3 half, Rational3 position, Rational mass) {
-  BodySpec b;
-  b.name = name;
-  ShapeSpec p;
-  p.type = ShapeType::Box;
-  p.halfExtents = half;
-  b.parts = {p};
-  b.position = position;
+  BodySpec b = test::box(name.c_str(), half, position);
   b.mass = mass;
   b.restitution = Rational{0, 1};
   b.friction = Rational{3, 5};
