@@ -343,6 +343,26 @@ TEST(ScenarioOrientation, NonUnitAndZeroQuaternionsAreRejected) {
   EXPECT_NO_THROW(parse(body("[1, 0, 0, 0]")));
 }
 
+TEST(ScenarioBodies, TinyPartsAndUnknownShapesAreNamedAtTheirKey) {
+  // A 1e-30 m box was reported at the body as "mass properties ... (use fewer digits)"; an unknown
+  // shape type listed "sphere" and "box" but not "compound" (found by review).
+  auto body = [](const std::string& shape) {
+    return R"({"bodies": {"list": [{"name": "b", "shape": )" + shape + "}]}}";
+  };
+  EXPECT_TRUE(throwsError([&] { parse(body(R"({"type": "box", "halfExtents": ["1e-30", 1, 1]})")); },
+                          "$.bodies.list[0].shape.halfExtents[0]", "at least 0.000001 m"));
+  EXPECT_TRUE(throwsError([&] { parse(body(R"({"type": "sphere", "radius": 1e-7})")); },
+                          "$.bodies.list[0].shape.radius", "at least 0.000001 m"));
+  EXPECT_TRUE(throwsError(
+      [&] {
+        parse(body(R"({"type": "compound", "parts": [{"type": "sphere", "radius": 1e-9, "offset": [0, 0, 0]}]})"));
+      },
+      "$.bodies.list[0].shape.parts[0].radius", "at least 0.000001 m"));
+  EXPECT_TRUE(throwsError([&] { parse(body(R"({"type": "cone", "radius": 1})")); }, "$.bodies.list[0].shape.type",
+                          R"(one of "sphere", "box", "compound", got "cone")"));
+  EXPECT_NO_THROW(parse(body(R"({"type": "sphere", "radius": 0.000001})")));
+}
+
 TEST(ScenarioDerived, AValueWhoseDerivedConstantOverflowsIsNamedAsSuch) {
   // 1e-30 itself is a fine spacing or mass to write; what does not fit is 1/spacing or 1/mass.
   // The message must say so, not call the written value 1e30.

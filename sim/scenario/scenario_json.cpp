@@ -359,6 +359,10 @@ void parseTerrain(const Reader& r, const json& j, Scenario::Terrain& t, const Sc
   tooLarge(uint64_t(t.heightmap.width), uint64_t(t.heightmap.height));
 }
 
+/// The smallest radius or half extent a body part may have (m): below it the exact mass
+/// properties (r^5 in the inertia) outgrow 128-bit fractions, and no scalar resolves it anyway.
+const Rational kMinPartSize{1, 1000000};
+
 ShapeSpec parseShapePart(const Reader& r, const json& j, const std::string& p, bool allowOffset) {
   ShapeSpec part;
   if (allowOffset) r.object(j, p, {"type", "radius", "halfExtents", "offset"});
@@ -368,13 +372,16 @@ ShapeSpec parseShapePart(const Reader& r, const json& j, const std::string& p, b
     if (j.contains("halfExtents")) r.fail(p + ".halfExtents", "no 'halfExtents' for a sphere (use radius)");
     if (!j.contains("radius")) r.fail(p + ".radius", "a sphere radius in m (missing)");
     part.radius = r.positive(j["radius"], p + ".radius");
+    if (compare(part.radius, kMinPartSize) < 0)
+      r.failGot(p + ".radius", "a radius of at least 0.000001 m (1 micrometre)", j["radius"]);
   } else {
     if (j.contains("radius")) r.fail(p + ".radius", "no 'radius' for a box (use halfExtents)");
     if (!j.contains("halfExtents")) r.fail(p + ".halfExtents", "box half extents [x, y, z] in m (missing)");
     part.halfExtents = r.vector<3>(j["halfExtents"], p + ".halfExtents");
     for (int i = 0; i < 3; ++i)
-      if (part.halfExtents[size_t(i)].num <= 0)
-        r.failGot(p + ".halfExtents[" + std::to_string(i) + "]", "a positive half extent", j["halfExtents"][size_t(i)]);
+      if (part.halfExtents[size_t(i)].num <= 0 || compare(part.halfExtents[size_t(i)], kMinPartSize) < 0)
+        r.failGot(p + ".halfExtents[" + std::to_string(i) + "]", "a half extent of at least 0.000001 m (1 micrometre)",
+                  j["halfExtents"][size_t(i)]);
   }
   if (j.contains("offset")) part.offset = r.vector<3>(j["offset"], p + ".offset");
   return part;
@@ -399,6 +406,8 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
     for (size_t i = 0; i < sh["parts"].size(); ++i)
       b.parts.push_back(parseShapePart(r, sh["parts"][i], sp + ".parts[" + std::to_string(i) + "]", true));
   } else {
+    if (sh.contains("type") && sh["type"] != "sphere" && sh["type"] != "box")
+      r.failGot(sp + ".type", "one of \"sphere\", \"box\", \"compound\"", sh["type"]);
     if (sh.contains("parts")) r.fail(sp + ".parts", "no 'parts' unless \"type\": \"compound\"");
     b.parts.push_back(parseShapePart(r, sh, sp, false));
   }
