@@ -2,7 +2,7 @@
 // phase, then bodies against the terrain, with speculative contacts up to each body's reach this
 // tick) and the response (the soft step of sim/collision/contact_solver.h: sub-steps of gravity,
 // the gyroscopic term, warm start, solve, position integration and relax; then restitution and
-// damping; the continuous sweep of fast spheres against a heightmap; then mowing, and the grass
+// damping; the continuous sweep of fast bodies against a heightmap; then mowing, and the grass
 // pushed out of every body, with optional grass drag).
 #include <cmath>
 
@@ -21,9 +21,9 @@ void World<S>::detectContacts() {
   // How far each body can move this tick, (|v| + |w| r + |g| dt) dt (m): pairs and terrain that
   // close within it get speculative contacts, so no body passes through another, or through the
   // terrain below it, in one tick. The terrain test looks under the body's present position; a
-  // fast sphere that a slope turns within the tick is swept after the solve
-  // (continuous_terrain.h). Not covered: a fast box or compound turned by a heightmap slope, and a
-  // body sped up beyond its reach by another within the tick.
+  // fast single-part body that a slope turns within the tick is swept after the solve
+  // (continuous_terrain.h). Not covered: a fast compound turned by a heightmap slope, and a body
+  // sped up beyond its reach by another within the tick.
   const S dt = particleConsts_.dt;
   const S gravityGain = length3(gravityDt_.x(), gravityDt_.y(), gravityDt_.z());
   std::vector<S> reach(bodies_.size(), S(0)), grown(bodies_.size(), S(0));
@@ -137,7 +137,7 @@ bool World<S>::respondToContacts() {
   storeImpulses(bodies_, contacts_, contactRows_, solver_, impulseCache_);
   applyRestitution(bodies_, contactRows_, solver_);
   applyDamping(bodies_);
-  sweepFastSpheresAgainstTerrain(bodies_, start, terrain_, solver_.linearSlop);
+  sweepFastBodiesAgainstTerrain(bodies_, start, terrain_, solver_.linearSlop);
   if (bodiesFaulted(Stage::Response)) return false;
   mowGrass();
   // Grass: pushed out of every body (particle rows in parallel, bodies in id order).
