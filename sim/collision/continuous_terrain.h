@@ -3,11 +3,12 @@
 // are chosen where it is at the tick's start, and a slope that turns a fast fall into a fast
 // slide within the tick sends it on, sideways, into ground that had no contact. A 10 cm ball
 // dropped at 500 m/s onto hills ended ticks 22 cm inside the rising ground beside its landing
-// point, a 5 cm one wholly under it, and cubes 29 cm. So each fast single-part body's motion over
+// point, a 5 cm one wholly under it, and cubes 29 cm. So each fast body's motion over
 // the tick is swept against the terrain (the narrow phase at points of the path, a quarter of its
 // smallest size apart; a box at its end-of-tick rotation) and the body is moved back to the last
 // point before it would overlap by more than the slop; its velocity is kept (the next tick's
-// contacts take it), as Box2D keeps it at the time of impact. Compound bodies are not swept.
+// contacts take it), as Box2D keeps it at the time of impact. Compound bodies are swept with all
+// their parts, a quarter of their smallest part apart.
 #pragma once
 
 #include <algorithm>
@@ -22,26 +23,40 @@ namespace sg {
 /// 667 quarter radii: past this the points lie further apart than a quarter radius).
 inline constexpr int64_t kMaxSweepPoints = 256;
 
-/// The deepest overlap (m) with the terrain of single-part body `b` with its centre at `centre`
-/// (its present rotation); 0 when it touches nothing.
+/// The deepest overlap (m) with the terrain of body `b` with its centre of mass at `centre` (its
+/// present rotation); 0 when it touches nothing.
 template <class S>
 S deepestTerrainOverlap(const RigidBody<S>& b, const Vec3<S>& centre, const Terrain<S>& terrain,
                         std::vector<Contact<S>>& scratch) {
   scratch.clear();
-  if (b.parts[0].type == ShapeType::Sphere)
-    collideSphereTerrain(0, centre, b.parts[0].radius, terrain, scratch, S(0));
-  else
-    collideBoxTerrain(0, b.parts[0].halfExtents, Pose<S>{centre, b.rotation}, terrain, scratch, S(0));
+  for (const BodyPart<S>& part : b.parts) {
+    // As RigidBody::partPose, about `centre`: a part at the centre of mass skips the rotation.
+    const Vec3<S> at = part.offset == Vec3<S>::Zero() ? centre : Vec3<S>(centre + b.rotation * part.offset);
+    if (part.type == ShapeType::Sphere)
+      collideSphereTerrain(0, at, part.radius, terrain, scratch, S(0));
+    else
+      collideBoxTerrain(0, part.halfExtents, Pose<S>{at, b.rotation}, terrain, scratch, S(0));
+  }
   S deepest(0);
   for (const Contact<S>& c : scratch) deepest = maxS(deepest, c.penetration);
   return deepest;
 }
 
-/// Moves every awake single-part body (a sphere, or a box at its end-of-tick rotation) that moved
-/// more than half its smallest size (radius or half extent) since `start` back along its straight
-/// path to the last tested point, a quarter of that size apart, where it overlaps the heightmap
-/// by no more than `slop` (m). A body that already overlapped by more at the start is left to its
-/// contacts.
+/// The smallest radius or half extent of any of the body's parts (m).
+template <class S>
+S smallestPartSize(const RigidBody<S>& b) {
+  S smallest = b.parts[0].type == ShapeType::Sphere ? b.parts[0].radius : b.parts[0].halfExtents.x();
+  for (const BodyPart<S>& part : b.parts)
+    smallest = part.type == ShapeType::Sphere
+                   ? minS(smallest, part.radius)
+                   : minS(smallest, minS(part.halfExtents.x(), minS(part.halfExtents.y(), part.halfExtents.z())));
+  return smallest;
+}
+
+/// Moves every awake body (at its end-of-tick rotation) that moved more than half its smallest
+/// part size since `start` back along its straight path to the last tested point, a quarter of
+/// that size apart, where it overlaps the heightmap by no more than `slop` (m). A body that
+/// already overlapped by more at the start is left to its contacts.
 template <class S>
 void sweepFastBodiesAgainstTerrain(std::vector<RigidBody<S>>& bodies, const std::vector<Vec3<S>>& start,
                                    const Terrain<S>& terrain, S slop) {
@@ -49,11 +64,8 @@ void sweepFastBodiesAgainstTerrain(std::vector<RigidBody<S>>& bodies, const std:
   std::vector<Contact<S>> scratch;
   for (size_t i = 0; i < bodies.size(); ++i) {
     RigidBody<S>& b = bodies[i];
-    if (b.asleep || b.parts.size() != 1) continue;
-    const BodyPart<S>& part = b.parts[0];
-    const S size = part.type == ShapeType::Sphere
-                       ? part.radius
-                       : minS(part.halfExtents.x(), minS(part.halfExtents.y(), part.halfExtents.z()));
+    if (b.asleep) continue;
+    const S size = smallestPartSize(b);
     const Vec3<S> moved = b.position - start[i];
     const S half = size / S(2);
     if (!(abs(moved.x()) > half) && !(abs(moved.y()) > half) && !(abs(moved.z()) > half)) continue;

@@ -21,9 +21,9 @@ void World<S>::detectContacts() {
   // How far each body can move this tick, (|v| + |w| r + |g| dt) dt (m): pairs and terrain that
   // close within it get speculative contacts, so no body passes through another, or through the
   // terrain below it, in one tick. The terrain test looks under the body's present position; a
-  // fast single-part body that a slope turns within the tick is swept after the solve
-  // (continuous_terrain.h). Not covered: a fast compound turned by a heightmap slope, and a body
-  // sped up beyond its reach by another within the tick.
+  // fast body that a slope turns within the tick is swept after the solve (continuous_terrain.h;
+  // at its end-of-tick rotation). Not covered: a body sped up beyond its reach by another within
+  // the tick.
   const S dt = particleConsts_.dt;
   const S gravityGain = length3(gravityDt_.x(), gravityDt_.y(), gravityDt_.z());
   std::vector<S> reach(bodies_.size(), S(0)), grown(bodies_.size(), S(0));
