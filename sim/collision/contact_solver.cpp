@@ -301,86 +301,104 @@ void updateSeparations(const std::vector<RigidBody<S>>& bodies, std::vector<Cont
     row.separationNow = row.separation + (anchorDifference(bodies, row) - row.anchorGap).dot(row.normal.dir);
 }
 
+namespace {
+
+/// The normal row of one contact (soft when `useBias`); false when the row sits this sweep out (a
+/// speculative row in the relax).
+template <class S>
+bool solveNormal(std::vector<RigidBody<S>>& bodies, ContactRow<S>& row, const SolverSettings<S>& settings,
+                 bool useBias) {
+  ContactAxis<S>& n = row.normal;
+  const S s = row.separationNow;
+  S bias(0), massScale(1), impulseScale(0);
+  if (s > S(0)) {
+    // Speculative: close at most the gap in this sub-step. Only in the solve, which the
+    // position integration follows; in the relax it would act on the *next* sub-step's motion
+    // (a ball 2 cm above the ground at the tick's end bounced there, a centimetre early, and
+    // lost m g x that gap of energy per bounce).
+    if (!useBias) return false;
+    bias = s * settings.invSubstep;
+  } else if (useBias) {
+    const Softness<S>& soft = row.b == kTerrainBody ? settings.staticSoftness : settings.bodySoftness;
+    bias = maxS(soft.biasRate * s, -settings.maxPushVelocity);
+    massScale = soft.massScale;
+    impulseScale = soft.impulseScale;
+  }
+  // Normal: push apart until the bodies stop closing (faster than the bias allows); never pull.
+  const S vn = axisVelocity(bodies, row, n);
+  // A speculative contact that will not close in this sub-step lets go of all its impulse. Said
+  // in velocities (the impulse's own velocity change against the margin), because the product
+  // mass x (vn + s / h) of a heavy fast body overflows fx16 long before any impulse does.
+  const bool released = s > S(0) && vn + bias > S(0) && !(n.impulse * n.invMass > vn + bias);
+  const S lambda = released ? S(0) : S(-n.mass * massScale * (vn + bias) - impulseScale * n.impulse);
+  const S total = released ? S(0) : maxS(n.impulse + lambda, S(0));
+  applyAxisImpulse(bodies, row, n, S(total - n.impulse));
+  n.impulse = total;
+  // The fastest approach any push met. Not just the first: a ball that left the ground at V
+  // comes back down through the same discrete positions (the integrator is time-reversible)
+  // and lands exactly on the surface, where rounding makes a push of ~1e-16 one sub-step
+  // before the real one; taking that approach (V - g h) lost g h of speed per bounce.
+  if (total > S(0) && vn < row.impactVelocity) {
+    row.impactVelocity = vn;
+    row.impactGap = maxS(s, S(0));
+  }
+  row.maxImpulseN = maxS(row.maxImpulseN, total);
+  return true;
+}
+
+/// The friction rows of one contact, within the cone of its normal impulse so far.
+template <class S>
+void solveFriction(std::vector<RigidBody<S>>& bodies, ContactRow<S>& row) {
+  const ContactAxis<S>& n = row.normal;
+  // Friction: stop the sliding velocity, the tangent impulse kept inside the Coulomb cone
+  // |t| <= mu x normal impulse. Per-axis clamps (a pyramid) gave up to sqrt(2) mu N along the
+  // diagonals and not opposite the velocity: a box on a slope 27 deg off its tangent axes slid
+  // along one axis only, and a box 45 deg off held at 1.3 times its friction angle.
+  const S limit = row.friction * n.impulse;
+  const S wanted1 = row.t1.impulse - axisVelocity(bodies, row, row.t1) * row.t1.mass;
+  if (row.slidingAxes) {
+    // Sliding: t1 is along the slide and comes first, up to the whole cone; t2 (across) gets
+    // what is left. Scaling the pair instead let the corners of a sliding box keep sideways
+    // impulses that cancel between them (nothing in the sweep removes those) at 6 % of the
+    // cone: the box slid with 94 % of its kinetic friction, 4 times too far near the
+    // friction angle.
+    const S total1 = std::clamp(wanted1, S(-limit), limit);
+    applyAxisImpulse(bodies, row, row.t1, S(total1 - row.t1.impulse));
+    row.t1.impulse = total1;
+    const S wanted2 = row.t2.impulse - axisVelocity(bodies, row, row.t2) * row.t2.mass;
+    const S used = abs(total1);
+    // sqrt(limit^2 - t1^2) as a product of roots: (limit - |t1|)(limit + |t1|) of an 8 t block's
+    // impulses overflows fx16.
+    const S left = sqrtS(S(limit - used)) * sqrtS(S(limit + used));
+    const S total2 = std::clamp(wanted2, S(-left), left);
+    applyAxisImpulse(bodies, row, row.t2, S(total2 - row.t2.impulse));
+    row.t2.impulse = total2;
+    return;
+  }
+  // At rest (fixed axes): both axes' targets from the same velocity (a sequential t1 then t2
+  // turns the pair's direction towards t1, which near the friction angle let a box slip 6 %
+  // further on the diagonal), the pair scaled onto the cone (Jolt clamps the pair the same way).
+  const S wanted2 = row.t2.impulse - axisVelocity(bodies, row, row.t2) * row.t2.mass;
+  S total1 = wanted1, total2 = wanted2;
+  const S length = length3(wanted1, wanted2, S(0));
+  if (length > limit) {
+    const S scale = limit / length;  // length > limit >= 0: scale < 1
+    total1 = wanted1 * scale;
+    total2 = wanted2 * scale;
+  }
+  applyAxisImpulse(bodies, row, row.t1, S(total1 - row.t1.impulse));
+  row.t1.impulse = total1;
+  applyAxisImpulse(bodies, row, row.t2, S(total2 - row.t2.impulse));
+  row.t2.impulse = total2;
+}
+
+}  // namespace
+
 template <class S>
 void solveContacts(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows,
                    const SolverSettings<S>& settings, bool useBias) {
-  for (ContactRow<S>& row : rows) {
-    ContactAxis<S>& n = row.normal;
-    const S s = row.separationNow;
-    S bias(0), massScale(1), impulseScale(0);
-    if (s > S(0)) {
-      // Speculative: close at most the gap in this sub-step. Only in the solve, which the
-      // position integration follows; in the relax it would act on the *next* sub-step's motion
-      // (a ball 2 cm above the ground at the tick's end bounced there, a centimetre early, and
-      // lost m g x that gap of energy per bounce).
-      if (!useBias) continue;
-      bias = s * settings.invSubstep;
-    } else if (useBias) {
-      const Softness<S>& soft = row.b == kTerrainBody ? settings.staticSoftness : settings.bodySoftness;
-      bias = maxS(soft.biasRate * s, -settings.maxPushVelocity);
-      massScale = soft.massScale;
-      impulseScale = soft.impulseScale;
-    }
-    // Normal: push apart until the bodies stop closing (faster than the bias allows); never pull.
-    const S vn = axisVelocity(bodies, row, n);
-    // A speculative contact that will not close in this sub-step lets go of all its impulse. Said
-    // in velocities (the impulse's own velocity change against the margin), because the product
-    // mass x (vn + s / h) of a heavy fast body overflows fx16 long before any impulse does.
-    const bool released = s > S(0) && vn + bias > S(0) && !(n.impulse * n.invMass > vn + bias);
-    const S lambda = released ? S(0) : S(-n.mass * massScale * (vn + bias) - impulseScale * n.impulse);
-    const S total = released ? S(0) : maxS(n.impulse + lambda, S(0));
-    applyAxisImpulse(bodies, row, n, S(total - n.impulse));
-    n.impulse = total;
-    // The fastest approach any push met. Not just the first: a ball that left the ground at V
-    // comes back down through the same discrete positions (the integrator is time-reversible)
-    // and lands exactly on the surface, where rounding makes a push of ~1e-16 one sub-step
-    // before the real one; taking that approach (V - g h) lost g h of speed per bounce.
-    if (total > S(0) && vn < row.impactVelocity) {
-      row.impactVelocity = vn;
-      row.impactGap = maxS(s, S(0));
-    }
-    row.maxImpulseN = maxS(row.maxImpulseN, total);
-    // Friction: stop the sliding velocity, the tangent impulse kept inside the Coulomb cone
-    // |t| <= mu x normal impulse. Per-axis clamps (a pyramid) gave up to sqrt(2) mu N along the
-    // diagonals and not opposite the velocity: a box on a slope 27 deg off its tangent axes slid
-    // along one axis only, and a box 45 deg off held at 1.3 times its friction angle.
-    const S limit = row.friction * n.impulse;
-    const S wanted1 = row.t1.impulse - axisVelocity(bodies, row, row.t1) * row.t1.mass;
-    if (row.slidingAxes) {
-      // Sliding: t1 is along the slide and comes first, up to the whole cone; t2 (across) gets
-      // what is left. Scaling the pair instead let the corners of a sliding box keep sideways
-      // impulses that cancel between them (nothing in the sweep removes those) at 6 % of the
-      // cone: the box slid with 94 % of its kinetic friction, 4 times too far near the
-      // friction angle.
-      const S total1 = std::clamp(wanted1, S(-limit), limit);
-      applyAxisImpulse(bodies, row, row.t1, S(total1 - row.t1.impulse));
-      row.t1.impulse = total1;
-      const S wanted2 = row.t2.impulse - axisVelocity(bodies, row, row.t2) * row.t2.mass;
-      const S used = abs(total1);
-      // sqrt(limit^2 - t1^2) as a product of roots: (limit - |t1|)(limit + |t1|) of an 8 t block's
-      // impulses overflows fx16.
-      const S left = sqrtS(S(limit - used)) * sqrtS(S(limit + used));
-      const S total2 = std::clamp(wanted2, S(-left), left);
-      applyAxisImpulse(bodies, row, row.t2, S(total2 - row.t2.impulse));
-      row.t2.impulse = total2;
-      continue;
-    }
-    // At rest (fixed axes): both axes' targets from the same velocity (a sequential t1 then t2
-    // turns the pair's direction towards t1, which near the friction angle let a box slip 6 %
-    // further on the diagonal), the pair scaled onto the cone (Jolt clamps the pair the same way).
-    const S wanted2 = row.t2.impulse - axisVelocity(bodies, row, row.t2) * row.t2.mass;
-    S total1 = wanted1, total2 = wanted2;
-    const S length = length3(wanted1, wanted2, S(0));
-    if (length > limit) {
-      const S scale = limit / length;  // length > limit >= 0: scale < 1
-      total1 = wanted1 * scale;
-      total2 = wanted2 * scale;
-    }
-    applyAxisImpulse(bodies, row, row.t1, S(total1 - row.t1.impulse));
-    row.t1.impulse = total1;
-    applyAxisImpulse(bodies, row, row.t2, S(total2 - row.t2.impulse));
-    row.t2.impulse = total2;
-  }
+  for (ContactRow<S>& row : rows)
+    if (solveNormal(bodies, row, settings, useBias)) solveFriction(bodies, row);
 }
 
 template <class S>
