@@ -11,6 +11,9 @@ namespace {
 }
 const char* broadphaseName(ParticleBroadphase b) { return b == ParticleBroadphase::Brute ? "brute" : "grid"; }
 const char* bodyBroadphaseName(BodyBroadphase b) { return b == BodyBroadphase::SweepAndPrune ? "sap" : "brute"; }
+const char* modelName(GrassModel m) {
+  return m == GrassModel::Blade ? "blade" : m == GrassModel::Pbd ? "pbd" : "thesis";
+}
 }  // namespace
 
 VariantSettings VariantSettings::parse(const std::string& text) {
@@ -24,7 +27,7 @@ VariantSettings VariantSettings::parse(const std::string& text) {
   while (in >> item) {
     const size_t eq = item.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
-      bad(item, "key=value with a key scalar, interp, broadphase, body-broadphase, dt, lod or threads");
+      bad(item, "key=value with a key scalar, interp, broadphase, body-broadphase, dt, lod, model or threads");
     const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
     // "scalar=fx16,scalar=double" silently took the last: a variant names each setting once.
     if (!seen.insert(key).second) bad(item, "each key once (" + key + " is given twice)");
@@ -71,8 +74,17 @@ VariantSettings VariantSettings::parse(const std::string& text) {
         v.lod = LodMode::Window;
       else
         bad(item, "lod=off or window");
+    } else if (key == "model") {
+      if (value == "thesis")
+        v.model = GrassModel::Thesis;
+      else if (value == "pbd")
+        v.model = GrassModel::Pbd;
+      else if (value == "blade")
+        v.model = GrassModel::Blade;
+      else
+        bad(item, "model=thesis, pbd or blade");
     } else {
-      bad(item, "a key scalar, interp, broadphase, body-broadphase, dt, lod or threads");
+      bad(item, "a key scalar, interp, broadphase, body-broadphase, dt, lod, model or threads");
     }
   }
   return v;
@@ -87,6 +99,7 @@ VariantSettings VariantSettings::over(const VariantSettings& base) const {
   if (timeStep) v.timeStep = timeStep;
   if (threads) v.threads = threads;
   if (lod) v.lod = lod;
+  if (model) v.model = model;
   return v;
 }
 
@@ -97,6 +110,20 @@ void VariantSettings::applyTo(Scenario& s) const {
   if (bodyBroadphase) s.bodies.bodyBroadphase = *bodyBroadphase;
   if (timeStep) s.timeStep = *timeStep;
   if (lod) s.lod.mode = *lod;
+  if (model && *model != s.particles.model) {
+    // Into or out of the blade model: the new model's acceleration, initial velocity and damping
+    // (scenario.h), as a scenario written for it would have by default.
+    if ((*model == GrassModel::Blade) != (s.particles.model == GrassModel::Blade)) {
+      const Scenario::Particles defaults;
+      const bool blade = *model == GrassModel::Blade;
+      s.particles.acceleration =
+          blade ? Rational3{Rational{0, 1}, Rational{-981, 100}, Rational{0, 1}} : defaults.acceleration;
+      s.particles.initialVelocity =
+          blade ? Rational3{Rational{0, 1}, Rational{0, 1}, Rational{0, 1}} : defaults.initialVelocity;
+      s.particles.damping = blade ? Rational{1, 1} : defaults.damping;
+    }
+    s.particles.model = *model;
+  }
 }
 
 VariantSettings VariantSettings::resolvedFrom(const Scenario& s) {
@@ -107,6 +134,7 @@ VariantSettings VariantSettings::resolvedFrom(const Scenario& s) {
   v.bodyBroadphase = s.bodies.bodyBroadphase;
   v.timeStep = s.timeStep;
   v.lod = s.lod.mode;
+  if (s.particles.model != GrassModel::Thesis) v.model = s.particles.model;
   return v;
 }
 
@@ -119,6 +147,7 @@ std::string VariantSettings::describe() const {
   if (bodyBroadphase) add(std::string("body-broadphase=") + bodyBroadphaseName(*bodyBroadphase));
   if (timeStep) add("dt=" + timeStep->toString());
   if (lod) add(std::string("lod=") + (*lod == LodMode::Window ? "window" : "off"));
+  if (model) add(std::string("model=") + modelName(*model));
   if (threads) add("threads=" + std::to_string(*threads));
   return out;
 }
@@ -126,7 +155,9 @@ std::string VariantSettings::describe() const {
 bool VariantSettings::mustBeIdenticalTo(const VariantSettings& reference) const {
   const VariantSettings mine = over(reference);
   return mine.scalar == reference.scalar && mine.interpolation == reference.interpolation &&
-         mine.timeStep == reference.timeStep && mine.lod.value_or(LodMode::Off) == reference.lod.value_or(LodMode::Off);
+         mine.timeStep == reference.timeStep &&
+         mine.lod.value_or(LodMode::Off) == reference.lod.value_or(LodMode::Off) &&
+         mine.model.value_or(GrassModel::Thesis) == reference.model.value_or(GrassModel::Thesis);
 }
 
 }  // namespace sg

@@ -1,5 +1,5 @@
 // Variant settings: what a run may change without changing the scenario text (scalar type,
-// interpolation, broad phases, time step, threads). Written "key=value" (comma or space
+// interpolation, broad phases, time step, level of detail, grass model, threads). Written "key=value" (comma or space
 // separated); the resolved, complete form is stored in every recording's header.
 #pragma once
 
@@ -20,6 +20,10 @@ struct VariantSettings {
   std::optional<Rational> timeStep;              ///< s per tick
   std::optional<int> threads;                    ///< not part of the state: must be bit-identical
   std::optional<LodMode> lod;                    ///< off: the whole field; window: around the camera
+  /// thesis, pbd or blade. Switching to or from blade also takes the new model's defaults for the
+  /// particles' acceleration, initial velocity and damping (the thesis' 1 m/s^2 lift is not a blade's
+  /// gravity); everything else stays.
+  std::optional<GrassModel> model;
 
   /// Parses "interp=2", "scalar=fx16,dt=1/120", ...; later keys override earlier ones.
   /// Throws std::invalid_argument with "key=value: expected ..." on a bad setting.
@@ -27,7 +31,8 @@ struct VariantSettings {
   /// This on top of `base` (keys set here win).
   VariantSettings over(const VariantSettings& base) const;
   void applyTo(Scenario& scenario) const;
-  /// Every setting of a scenario with this variant applied (threads omitted).
+  /// Every setting of a scenario with this variant applied (threads omitted; the model only when
+  /// it is not thesis, so recordings made before the key existed keep their resolved text).
   static VariantSettings resolvedFrom(const Scenario& scenario);
   /// "scalar=fx32 interp=1 broadphase=grid body-broadphase=brute dt=1/60" (set keys only).
   std::string describe() const;

@@ -343,11 +343,11 @@ struct Recovery {
 /// track (the rest of the meadow never sees the body). "Recovered": tilt level 0 and tip offset
 /// below 1 cm for every tuft.
 template <class S>
-Recovery measureRecovery(ConstraintMode mode, double horizonSeconds) {
+Recovery measureRecovery(GrassModel mode, double horizonSeconds) {
   Scenario s = loadScenarioFile(test::sourcePath("scenarios/thesis-bodies.json"));
   s.wind.schedule.clear();
   s.script.clear();
-  s.particles.constraintMode = mode;
+  s.particles.model = mode;
   s.particles.initialVelocity = r3(0, 0, 0);
   s.field.patchesX = 33;
   s.field.patchesZ = 9;
@@ -413,7 +413,7 @@ const double kEndAngle = std::asin(0.01 / kRod);      // tip offset 1 cm: 0.02 r
 const double kTiltAngle = std::acos(1 - 0.1 / kRod);  // tilt level 1 at a 0.1 m sink: 0.6435 rad
 
 TEST(BodyAccuracy, GrassRecoversAfterABodyLeavesThesisMode) {
-  const Recovery r = measureRecovery<Fx32>(ConstraintMode::Thesis, 20);
+  const Recovery r = measureRecovery<Fx32>(GrassModel::Thesis, 20);
   report("thesis", r);
   // A body moves particle positions only (thesis §4), so a pushed tuft keeps its purely vertical
   // hidden velocity v_y (v_inf (1 - q^n), v_inf = 32.8 m/s: 1.47 m/s after 1.5 s) and never gains
@@ -442,7 +442,7 @@ TEST(BodyAccuracy, GrassRecoversAfterABodyLeavesThesisMode) {
 }
 
 TEST(BodyAccuracy, GrassRecoversAfterABodyLeavesPbdMode) {
-  const Recovery r = measureRecovery<Fx32>(ConstraintMode::Pbd, 200);
+  const Recovery r = measureRecovery<Fx32>(GrassModel::Pbd, 200);
   report("pbd", r);
   // A bent tuft is a pendulum under the upward a = 1 m/s^2 (omega^2 = a / L = 2 /s^2, period
   // 4.4 s). Its angular amplitude decays exponentially at gamma = c / 2 + omega^2 dt / 2:

@@ -30,7 +30,8 @@ nlohmann::json goldens() {
 /// operations in the same order on every build and architecture (docs/determinism.md).
 const std::vector<GoldenCase> kGoldenCases = [] {
   std::vector<GoldenCase> cases;
-  for (const char* scenario : {"thesis-meadow", "hilly-meadow", "thesis-bodies", "mower-field", "lod-crossing"})
+  for (const char* scenario :
+       {"thesis-meadow", "hilly-meadow", "thesis-bodies", "mower-field", "lod-crossing", "blade-bodies"})
     for (const char* scalar : {"fx32", "fx16", "float", "double"}) cases.push_back({scenario, scalar});
   return cases;
 }();

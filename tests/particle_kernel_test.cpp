@@ -584,7 +584,7 @@ TEST_P(KernelWorlds, EveryTickHashEqualBetweenKernels) {
   Scenario s = loadScenarioFile(test::sourcePath(std::string("scenarios/") + c.scenario + ".json"));
   s.scalar = *parseScalarKind(c.scalar);
   s.particles.interpolation = c.k;
-  if (c.pbd) s.particles.constraintMode = ConstraintMode::Pbd;
+  if (c.pbd) s.particles.model = GrassModel::Pbd;
   auto reference = makeWorld(s, 1);
   auto vector = makeWorld(s, 2);
   reference->setParticleKernel(ParticleKernel::Scalar);

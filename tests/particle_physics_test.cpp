@@ -19,7 +19,7 @@ double d(S v) {
 // ---- a tuft started upright with zero velocity and no wind stays exactly upright ----------------
 
 template <class S>
-void expectStaysUpright(ConstraintMode mode) {
+void expectStaysUpright(GrassModel mode) {
   auto w = makeTyped<S>(test::singleTuft(mode));
   const auto& p = w->particles();
   const S rod = w->particleConstants().rodLength;
@@ -40,17 +40,17 @@ void expectStaysUpright(ConstraintMode mode) {
   EXPECT_EQ(w->patches().tipOffsetZ[0], S(0));
 }
 
-TEST(Upright, Fx32ThesisMode) { expectStaysUpright<Fx32>(ConstraintMode::Thesis); }
-TEST(Upright, Fx32PbdMode) { expectStaysUpright<Fx32>(ConstraintMode::Pbd); }
-TEST(Upright, Fx16ThesisMode) { expectStaysUpright<Fx16>(ConstraintMode::Thesis); }
-TEST(Upright, Fx16PbdMode) { expectStaysUpright<Fx16>(ConstraintMode::Pbd); }
+TEST(Upright, Fx32ThesisMode) { expectStaysUpright<Fx32>(GrassModel::Thesis); }
+TEST(Upright, Fx32PbdMode) { expectStaysUpright<Fx32>(GrassModel::Pbd); }
+TEST(Upright, Fx16ThesisMode) { expectStaysUpright<Fx16>(GrassModel::Thesis); }
+TEST(Upright, Fx16PbdMode) { expectStaysUpright<Fx16>(GrassModel::Pbd); }
 
 // ---- thesis mode hides a growing upward velocity -------------------------------------------------
 // With v untouched by the projection, v_{n+1} = (v_n + a dt) q with q = damping^dt, so from rest
 // v_n = v_inf (1 - q^n), v_inf = a dt q / (1 - q): 32.8 m/s for the thesis values, while the
 // tuft itself never moves. docs/physics-notes.md discusses it.
 TEST(ThesisMode, HiddenUpwardVelocityFollowsTheClosedForm) {
-  auto w = makeTyped<double>(test::singleTuft(ConstraintMode::Thesis));
+  auto w = makeTyped<double>(test::singleTuft(GrassModel::Thesis));
   const double dt = 1.0 / 60.0, q = std::pow(0.97L, 1.0L / 60.0L), a = 1.0;
   const double vInf = a * dt * q / (1.0 - q);
   EXPECT_NEAR(vInf, 32.82, 0.01);
@@ -66,8 +66,8 @@ TEST(ThesisMode, HiddenUpwardVelocityFollowsTheClosedForm) {
 }
 
 TEST(ThesisMode, Fx32HiddenVelocityMatchesDoubleWithinRounding) {
-  auto wf = makeTyped<Fx32>(test::singleTuft(ConstraintMode::Thesis));
-  auto wd = makeTyped<double>(test::singleTuft(ConstraintMode::Thesis));
+  auto wf = makeTyped<Fx32>(test::singleTuft(GrassModel::Thesis));
+  auto wd = makeTyped<double>(test::singleTuft(GrassModel::Thesis));
   for (int n = 0; n < 3000; ++n) {
     ASSERT_TRUE(wf->step(TickInput{}).ok);
     ASSERT_TRUE(wd->step(TickInput{}).ok);
@@ -81,7 +81,7 @@ TEST(ThesisMode, Fx32HiddenVelocityMatchesDoubleWithinRounding) {
 }
 
 TEST(PbdMode, NoHiddenVelocityAtRest) {
-  auto w = makeTyped<double>(test::singleTuft(ConstraintMode::Pbd));
+  auto w = makeTyped<double>(test::singleTuft(GrassModel::Pbd));
   for (int n = 0; n < 1000; ++n) ASSERT_TRUE(w->step(TickInput{}).ok);
   // The projection removes exactly what the acceleration added: v stays at rounding level.
   EXPECT_LT(std::fabs(w->particles().vy[0]), 1e-12);
@@ -105,7 +105,7 @@ double exactPeriod(double L, double a, double theta0) {
 
 template <class S>
 double measurePeriod(const Rational& dt, double theta0, int periods) {
-  Scenario s = test::singleTuft(ConstraintMode::Pbd);
+  Scenario s = test::singleTuft(GrassModel::Pbd);
   s.timeStep = dt;
   s.particles.damping = Rational{1, 1};
   auto w = makeTyped<S>(s);
@@ -161,7 +161,7 @@ TEST(PbdPendulum, Fx32PeriodMatchesDouble) {
 
 template <class S>
 void expectDegenerateAnchorRecovers() {
-  auto w = makeTyped<S>(test::singleTuft(ConstraintMode::Thesis));
+  auto w = makeTyped<S>(test::singleTuft(GrassModel::Thesis));
   auto& p = w->mutableParticles();
   p.px[0] = p.anchorX[0];
   p.py[0] = p.anchorY[0];
@@ -169,7 +169,7 @@ void expectDegenerateAnchorRecovers() {
   p.vx[0] = p.vy[0] = p.vz[0] = S(0);
   // The integration moves it up by a dt^2 first, so force the exact case through the constraint
   // by removing the acceleration.
-  Scenario s = test::singleTuft(ConstraintMode::Thesis);
+  Scenario s = test::singleTuft(GrassModel::Thesis);
   s.particles.acceleration = {Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
   auto w2 = makeTyped<S>(s);
   auto& q = w2->mutableParticles();

@@ -274,6 +274,34 @@ TEST(Variant, ParsesDescribesAndOverrides) {
   }
 }
 
+// The grass model as a variant: described only when it is not thesis (recordings made before the
+// key keep their resolved text), never identical to another model, and switching into or out of
+// the blade model takes that model's acceleration, initial velocity and damping defaults.
+TEST(Variant, ModelSwitchesTheModelAndItsDefaults) {
+  const VariantSettings base = VariantSettings::resolvedFrom(test::thesisMeadow());
+  EXPECT_FALSE(VariantSettings::parse("model=blade").mustBeIdenticalTo(base));
+  EXPECT_FALSE(VariantSettings::parse("model=pbd").mustBeIdenticalTo(base));
+  EXPECT_TRUE(VariantSettings::parse("model=thesis").mustBeIdenticalTo(base));
+  Scenario s = test::thesisMeadow();
+  VariantSettings::parse("model=blade").applyTo(s);
+  EXPECT_EQ(s.particles.model, GrassModel::Blade);
+  EXPECT_EQ(s.particles.acceleration[1], (Rational{-981, 100}));
+  EXPECT_EQ(s.particles.initialVelocity[0], (Rational{0, 1}));
+  EXPECT_EQ(s.particles.damping, (Rational{1, 1}));
+  EXPECT_EQ(VariantSettings::resolvedFrom(s).describe(),
+            "scalar=fx32 interp=1 broadphase=grid body-broadphase=brute dt=1/60 lod=off model=blade");
+  VariantSettings::parse("model=pbd").applyTo(s);
+  EXPECT_EQ(s.particles.model, GrassModel::Pbd);
+  EXPECT_EQ(s.particles.acceleration, test::thesisMeadow().particles.acceleration);
+  EXPECT_EQ(s.particles.damping, test::thesisMeadow().particles.damping);
+  try {
+    VariantSettings::parse("model=rigid");
+    ADD_FAILURE() << "model=rigid parsed";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "model=rigid: expected model=thesis, pbd or blade");
+  }
+}
+
 // ---- committed recordings ----------------------------------------------------------------------
 // scenarios/recordings/*.sgr were made by .ci/rerecord; expected.json holds each one's final hash.
 // A change to the physics or the format that breaks them must say so and re-record.

@@ -265,6 +265,22 @@ const std::vector<BadCase> kValueCases = {
     {"MassZero", R"({"particles": {"mass": 0}})", "$.particles.mass", "positive"},
     {"ConstraintLengthZero", R"({"particles": {"constraintLength": 0}})", "$.particles.constraintLength", "positive"},
     {"ConstraintModeUnknown", R"({"particles": {"constraintMode": "rigid"}})", "$.particles.constraintMode", "\"pbd\""},
+    {"ModelUnknown", R"({"particles": {"model": "rigid"}})", "$.particles.model", "\"blade\""},
+    {"ModelAndConstraintMode", R"({"particles": {"model": "pbd", "constraintMode": "pbd"}})",
+     "$.particles.constraintMode", "not both"},
+    {"ConstraintModeBlade", R"({"particles": {"constraintMode": "blade"}})", "$.particles.constraintMode", "\"pbd\""},
+    {"BladeBlockWithoutModel", R"({"particles": {"blade": {"frequency": 1}}})", "$.particles.blade",
+     "\"model\": \"blade\""},
+    {"BladeFrequencyZero", R"({"particles": {"model": "blade", "blade": {"frequency": 0}}})",
+     "$.particles.blade.frequency", "positive"},
+    {"BladeFrequencyHuge", R"({"particles": {"model": "blade", "blade": {"frequency": 2000}}})",
+     "$.particles.blade.frequency", "1000 Hz"},
+    {"BladeDampingRatioNegative", R"({"particles": {"model": "blade", "blade": {"dampingRatio": -0.1}}})",
+     "$.particles.blade.dampingRatio", ""},
+    {"BladeTrampleTooLong", R"({"particles": {"model": "blade", "blade": {"trampleSeconds": 4000}}})",
+     "$.particles.blade.trampleSeconds", "3600"},
+    {"BladeUnknownKey", R"({"particles": {"model": "blade", "blade": {"stiffness": 3}}})", "$.particles.blade", "",
+     true},
     {"TiltDropDecreasing", R"({"particles": {"tiltDrop": [0.3, 0.2, 0.4]}})", "$.particles.tiltDrop[1]", "increasing"},
     {"TiltDropEqual", R"({"particles": {"tiltDrop": [0.2, 0.3, 0.3]}})", "$.particles.tiltDrop[2]", "increasing"},
     {"TiltDropNegative", R"({"particles": {"tiltDrop": [-0.1, 0.3, 0.4]}})", "$.particles.tiltDrop[0]", ""},
@@ -439,6 +455,23 @@ TEST_P(ScenarioScalarRange, RejectedExactlyByScalarsThatCannotHoldIt) {
 }
 
 const std::vector<ScalarCase> kScalarCases = {
+    // A blade too stiff for the explicit spring at dt = 1/60 (k dt^2 = 4.4), and one whose upward
+    // acceleration outruns its frequency (stiffness (2 pi 0.5)^2 - 50 < 0): no scalar runs them.
+    {"BladeTooStiffForTheTimeStep",
+     R"({"particles": {"model": "blade", "blade": {"frequency": 20}}})",
+     "$.particles.blade.frequency",
+     {ScalarKind::Fx32, ScalarKind::Fx16, ScalarKind::Float, ScalarKind::Double},
+     false},
+    {"BladeLiftOutrunsItsFrequency",
+     R"({"particles": {"model": "blade", "acceleration": [0, 50, 0], "blade": {"frequency": 0.5}}})",
+     "$.particles.blade.frequency",
+     {ScalarKind::Fx32, ScalarKind::Fx16, ScalarKind::Float, ScalarKind::Double},
+     false},
+    // A trample time so long that dt / T rounds to zero in fx16 (1.5e-5 resolution) but not fx32.
+    {"BladeTrampleDecayRoundsToZero",
+     R"({"timeStep": "1/1000", "particles": {"model": "blade", "blade": {"trampleSeconds": 3600}}})",
+     "$.particles.blade.trampleSeconds",
+     {ScalarKind::Fx16}},
     // A contact frequency fx32 rounds to 0 (2.3e-10 resolution), fx16 too; float and double hold it.
     {"ContactHertzRoundsToZero",
      R"({"bodies": {"contactHertz": 1e-12, "list": [{"name": "b", "shape": {"type": "sphere", "radius": 0.5}}]}})",

@@ -32,11 +32,11 @@ inline bool slowBuild() { return std::getenv("SIMGRASS_SLOW_BUILD") != nullptr; 
 inline Scenario thesisMeadow() { return parseScenario(defaultScenarioText(), "<built-in>", {}); }
 
 /// A scenario with one tuft (1 x 1 patches), no wind, given constraint mode.
-inline Scenario singleTuft(ConstraintMode mode) {
+inline Scenario singleTuft(GrassModel mode) {
   Scenario s = thesisMeadow();
   s.field.patchesX = s.field.patchesZ = 1;
   s.field.jitter = Rational{0, 1};
-  s.particles.constraintMode = mode;
+  s.particles.model = mode;
   s.particles.initialVelocity = {Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
   s.wind.schedule.clear();
   return s;

@@ -126,6 +126,22 @@ bool pushOut(ParticleArrays<S>& pa, size_t i, const GrassPusher<S>& pusher, BoxP
   return true;
 }
 
+/// Model blade, after a push moved particle i from `before`: the velocity component against the
+/// push goes (the body stops the tip, as a contact would), and the tip is trampled.
+template <class S>
+void bladeContact(ParticleArrays<S>& pa, size_t i, const Vec3<S>& before) {
+  if (!pa.trample.empty()) pa.trample[i] = S(1);
+  const Vec3<S> push = Vec3<S>(pa.px[i], pa.py[i], pa.pz[i]) - before;
+  const S length = length3(push.x(), push.y(), push.z());
+  if (length == S(0)) return;
+  const Vec3<S> n = push / length;
+  const S into = pa.vx[i] * n.x() + pa.vy[i] * n.y() + pa.vz[i] * n.z();
+  if (into >= S(0)) return;
+  pa.vx[i] -= n.x() * into;
+  pa.vy[i] -= n.y() * into;
+  pa.vz[i] -= n.z() * into;
+}
+
 }  // namespace
 
 namespace {
@@ -196,8 +212,10 @@ int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid
   }
   // One particle pushed out of a part it is within reach of; false where the stage must stop.
   const auto pushInside = [&](size_t i, const GrassPusher<S>& pusher) {
+    const Vec3<S> before(pa.px[i], pa.py[i], pa.pz[i]);
     if (!pushOut(pa, i, pusher, s.boxNormal)) return true;
     if (pushedPerBody) ++pushedPerBody[pusher.body];
+    if (s.bladeContact) bladeContact(pa, i, before);
     return !T::faultPending() && T::isFinite(pa.px[i]) && T::isFinite(pa.py[i]) && T::isFinite(pa.pz[i]);
   };
   // Storage rows [rowBegin, rowEnd): each holds one lattice row of the window. Per particle the

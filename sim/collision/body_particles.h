@@ -45,6 +45,10 @@ struct BodyParticleSettings {
   /// The rows' height marks (grass_candidates.h), fixed-point only. They change no bits; off only
   /// in the tests that check exactly that.
   bool heightMarks = true;
+  /// Model blade: a pushed tip also loses the velocity that carried it into the body (its spring
+  /// would otherwise build an inward velocity tick after tick), and is trampled when the particles
+  /// carry a trample level (sim/particles/blade.h). Thesis and pbd move the position only.
+  bool bladeContact = false;
 };
 
 /// Candidate ranges for every body part, in (body, part) order.

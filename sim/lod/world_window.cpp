@@ -38,6 +38,7 @@ void World<S>::initParticle(int64_t I, int64_t J, bool initialVelocity) {
   particles_.vx[q] = v.x();
   particles_.vy[q] = v.y();
   particles_.vz[q] = v.z();
+  if (!particles_.trample.empty()) particles_.trample[q] = S(0);
 }
 
 template <class S>

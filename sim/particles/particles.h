@@ -29,8 +29,12 @@ struct ParticleArrays {
   std::vector<S> px, py, pz;                 ///< position (m)
   std::vector<S> vx, vy, vz;                 ///< velocity (m/s)
   std::vector<S> anchorX, anchorY, anchorZ;  ///< rod anchor = tuft root on the ground (m)
-  void resize(size_t n) {
+  /// Model blade with trampling only (else empty): 1 when a body pressed the tip, decaying to 0
+  /// over the scenario's trampleSeconds (sim/particles/blade.h). State: saved and hashed.
+  std::vector<S> trample;
+  void resize(size_t n, bool tramples = false) {
     for (auto* v : {&px, &py, &pz, &vx, &vy, &vz, &anchorX, &anchorY, &anchorZ}) v->assign(n, S(0));
+    trample.assign(tramples ? n : 0, S(0));
   }
 };
 
@@ -41,6 +45,10 @@ struct ParticleConstants {
   S invDt{};           ///< 1/s
   S dampingPerTick{};  ///< damping^dt, from deterministicPow
   S rodLength{};       ///< L (m)
+  // model blade (sim/particles/blade.h); zero for the other models
+  S bladeStiffnessDt{};     ///< 1/s: stiffness * dt
+  S bladeDampingPerTick{};  ///< damping^dt exp(-blade damping rate * dt)
+  S trampleDecayPerTick{};  ///< dt / trampleSeconds
 };
 
 }  // namespace sg

@@ -13,8 +13,14 @@
 namespace sg {
 
 struct ScenarioConstants {
-  Rational invDt;                       ///< 1/s
-  Rational dampingPerTick;              ///< damping^dt (deterministicPow)
+  Rational invDt;           ///< 1/s
+  Rational dampingPerTick;  ///< damping^dt (deterministicPow)
+  // model blade only (zero otherwise)
+  Rational bladeStiffness;              ///< 1/s^2: (2 pi f)^2 - acceleration.y / L
+  Rational bladeDampingRate;            ///< 1/s: 4 pi dampingRatio f
+  Rational bladeStiffnessDt;            ///< 1/s: stiffness * dt, the recovery's velocity change per metre of offset
+  Rational bladeDampingPerTick;         ///< damping^dt exp(-dampingRate dt): both dampings, one factor
+  Rational trampleDecayPerTick;         ///< dt / trampleSeconds (0: no trampling)
   Rational halfRod;                     ///< L/2 (m)
   Rational invMass;                     ///< 1/kg
   Rational jitterAmplitude;             ///< m

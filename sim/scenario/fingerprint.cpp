@@ -24,8 +24,8 @@ uint64_t scenarioFingerprint(const Scenario& s) {
   HashSink h;
   const auto& f = s.field;
   const auto& p = s.particles;
-  putInts(h, {f.patchesX, f.patchesZ, f.atlasVariants, p.interpolation, int64_t(p.constraintMode),
-              int64_t(s.wind.travel), int64_t(s.scalar), s.terrain.flat ? 1 : 0, int64_t(s.terrain.heightmap.width),
+  putInts(h, {f.patchesX, f.patchesZ, f.atlasVariants, p.interpolation, int64_t(p.model), int64_t(s.wind.travel),
+              int64_t(s.scalar), s.terrain.flat ? 1 : 0, int64_t(s.terrain.heightmap.width),
               int64_t(s.terrain.heightmap.height)});
   h.put(s.seed);
   for (const Rational* r : {&s.timeStep, &f.spacing, &f.jitter, &f.centerX, &f.centerZ, &f.scaleY, &f.scaleXZ,
@@ -43,6 +43,10 @@ uint64_t scenarioFingerprint(const Scenario& s) {
     putRational(h, g.duration);
   }
   h.write(s.terrain.heightmap.samples.data(), s.terrain.heightmap.samples.size());  // bytes
+  if (p.model == GrassModel::Blade) {  // behind a tag, as the other optional parts
+    putInts(h, {0x626c616465});        // "blade"
+    for (const Rational* r : {&p.blade.frequency, &p.blade.dampingRatio, &p.blade.trampleSeconds}) putRational(h, *r);
+  }
   if (s.lod.mode == LodMode::Window) {
     putInts(h, {1, s.lod.windowX, s.lod.windowZ, s.lod.edgeSpacing, s.lod.edgeRows, s.lod.centerGiven ? 1 : 0});
     putRational(h, s.lod.centerX);

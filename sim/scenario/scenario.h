@@ -19,10 +19,11 @@ namespace sg {
 
 using Rational3 = std::array<Rational, 3>;
 
-/// How the rod constraint treats velocity after projecting the position back to length L.
-enum class ConstraintMode : uint8_t {
+/// How a tuft moves (docs/grass-models.md). Every model keeps the tip on its rod of length L.
+enum class GrassModel : uint8_t {
   Thesis,  ///< position projected, velocity untouched (Cyclone, as in the thesis)
   Pbd,     ///< position-based dynamics: velocity recomputed from the corrected position
+  Blade,   ///< a stiff blade: recovery toward the upright rest pose, gravity, trampling
 };
 /// Which row a gust reaches first.
 enum class WindTravel : uint8_t {
@@ -124,13 +125,28 @@ struct Scenario {
   } field;
 
   struct Particles {
-    int interpolation = 1;                                                      ///< k: one particle per k x k patches
-    Rational constraintLength{1, 1};                                            ///< m, rod length L
-    Rational3 initialVelocity{Rational{1, 5}, Rational{1, 5}, Rational{1, 5}};  ///< m/s
-    Rational3 acceleration{Rational{0, 1}, Rational{1, 1}, Rational{0, 1}};     ///< m/s^2
-    Rational mass{1, 1};                                                        ///< kg
-    Rational damping{97, 100};  ///< velocity factor per second (v *= damping^dt)
-    ConstraintMode constraintMode = ConstraintMode::Thesis;
+    int interpolation = 1;            ///< k: one particle per k x k patches
+    Rational constraintLength{1, 1};  ///< m, rod length L
+    /// m/s (model blade: 0 unless given)
+    Rational3 initialVelocity{Rational{1, 5}, Rational{1, 5}, Rational{1, 5}};
+    /// m/s^2: thesis and pbd lift the tuft by 1 m/s^2 (the thesis' value); model blade defaults
+    /// to gravity, (0, -9.81, 0), its stiffness holding it up
+    Rational3 acceleration{Rational{0, 1}, Rational{1, 1}, Rational{0, 1}};
+    Rational mass{1, 1};        ///< kg
+    Rational damping{97, 100};  ///< velocity factor per second (v *= damping^dt); model blade: 1 unless given
+    /// JSON "model" ("constraintMode" in files written before the blade model; thesis or pbd).
+    GrassModel model = GrassModel::Thesis;
+    /// The blade model's constants (model "blade" only; docs/grass-models.md), as a user thinks of
+    /// a blade: how fast it sways and how quickly that dies away, in still air. The world derives
+    /// the recovery stiffness (2 pi frequency)^2 - acceleration.y / L (1/s^2) and the damping rate
+    /// 4 pi dampingRatio frequency (1/s) from them, exactly (pi as a fraction good to 1e-16).
+    struct Blade {
+      Rational frequency{1, 2};      ///< Hz: small sways under the scenario's acceleration
+      Rational dampingRatio{3, 10};  ///< of critical: 0.3 rings down to 5 % in about 1.6 periods
+      /// s: a pressed blade loses its stiffness and regains it linearly over this time (0: no
+      /// trampling). Under gravity it lies down until its stiffness carries its weight again.
+      Rational trampleSeconds{10, 1};
+    } blade;
     /// Tilt brightness thresholds: level n when the tip sinks more than tiltDrop[n-1] below L.
     std::array<Rational, 3> tiltDrop{Rational{1, 5}, Rational{3, 10}, Rational{2, 5}};
   } particles;

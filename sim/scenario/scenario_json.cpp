@@ -267,11 +267,50 @@ void parseField(const Reader& r, const json& j, Scenario::Field& f) {
   if (j.contains("atlasVariants")) f.atlasVariants = int(r.integer(j["atlasVariants"], p + ".atlasVariants", 1, 16));
 }
 
+void parseBlade(const Reader& r, const json& j, Scenario::Particles::Blade& b) {
+  const std::string p = "$.particles.blade";
+  r.object(j, p, {"frequency", "dampingRatio", "trampleSeconds"});
+  if (j.contains("frequency")) {
+    b.frequency = r.positive(j["frequency"], p + ".frequency");
+    if (compare(b.frequency, Rational{1000, 1}) > 0)
+      r.failGot(p + ".frequency", "a sway frequency above 0 and up to 1000 Hz", j["frequency"]);
+  }
+  if (j.contains("dampingRatio")) {
+    b.dampingRatio = r.nonNegative(j["dampingRatio"], p + ".dampingRatio");
+    if (compare(b.dampingRatio, Rational{100, 1}) > 0)
+      r.failGot(p + ".dampingRatio", "a damping ratio from 0 to 100", j["dampingRatio"]);
+  }
+  if (j.contains("trampleSeconds")) {
+    b.trampleSeconds = r.nonNegative(j["trampleSeconds"], p + ".trampleSeconds");
+    if (compare(b.trampleSeconds, Rational{3600, 1}) > 0)
+      r.failGot(p + ".trampleSeconds", "a recovery time from 0 to 3600 s", j["trampleSeconds"]);
+  }
+}
+
 void parseParticles(const Reader& r, const json& j, Scenario::Particles& s) {
   const std::string p = "$.particles";
   r.object(j, p,
-           {"interpolation", "constraintLength", "initialVelocity", "acceleration", "mass", "damping", "constraintMode",
-            "tiltDrop"});
+           {"interpolation", "constraintLength", "initialVelocity", "acceleration", "mass", "damping", "model",
+            "constraintMode", "blade", "tiltDrop"});
+  // The model first: it sets the defaults of the keys below.
+  if (j.contains("model") && j.contains("constraintMode"))
+    r.fail(p + ".constraintMode", "either \"model\" or its old name \"constraintMode\", not both");
+  if (j.contains("model"))
+    s.model =
+        r.choice<GrassModel>(j["model"], p + ".model",
+                             {{"thesis", GrassModel::Thesis}, {"pbd", GrassModel::Pbd}, {"blade", GrassModel::Blade}});
+  if (j.contains("constraintMode"))
+    s.model = r.choice<GrassModel>(j["constraintMode"], p + ".constraintMode",
+                                   {{"thesis", GrassModel::Thesis}, {"pbd", GrassModel::Pbd}});
+  if (s.model == GrassModel::Blade) {  // a real blade: at rest, under gravity, held up by its stiffness
+    s.initialVelocity = {Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
+    s.acceleration = {Rational{0, 1}, Rational{-981, 100}, Rational{0, 1}};
+    s.damping = Rational{1, 1};  // its dampingRatio is the damping
+  }
+  if (j.contains("blade")) {
+    if (s.model != GrassModel::Blade) r.fail(p + ".blade", "no 'blade' block unless \"model\": \"blade\"");
+    parseBlade(r, j["blade"], s.blade);
+  }
   if (j.contains("interpolation")) s.interpolation = int(r.integer(j["interpolation"], p + ".interpolation", 1, 4));
   if (j.contains("constraintLength")) s.constraintLength = r.positive(j["constraintLength"], p + ".constraintLength");
   if (j.contains("initialVelocity")) s.initialVelocity = r.vector<3>(j["initialVelocity"], p + ".initialVelocity");
@@ -281,9 +320,6 @@ void parseParticles(const Reader& r, const json& j, Scenario::Particles& s) {
     s.damping = r.positive(j["damping"], p + ".damping");
     if (compare(s.damping, Rational{1, 1}) > 0) r.failGot(p + ".damping", "a damping factor in (0, 1]", j["damping"]);
   }
-  if (j.contains("constraintMode"))
-    s.constraintMode = r.choice<ConstraintMode>(j["constraintMode"], p + ".constraintMode",
-                                                {{"thesis", ConstraintMode::Thesis}, {"pbd", ConstraintMode::Pbd}});
   if (j.contains("tiltDrop")) {
     s.tiltDrop = r.vector<3>(j["tiltDrop"], p + ".tiltDrop");
     for (int i = 0; i < 3; ++i) {

@@ -116,6 +116,14 @@ void checkResolution(const Scenario& s) {
   nonZero(s.wind.travelSpeed, "$.wind.travelSpeed", "a travel speed");
   auto perTick = deterministicPow(s.particles.damping, s.timeStep);
   nonZero(perTick, "$.particles.damping", "a damping whose per-tick factor damping^dt stays a value");
+  if (s.particles.model == GrassModel::Blade) {
+    const ScenarioConstants c = deriveConstants(s);
+    nonZero(c.bladeStiffnessDt, "$.particles.blade.frequency", "a frequency whose stiffness x timeStep");
+    nonZero(c.bladeDampingPerTick, "$.particles.blade.dampingRatio", "a damping ratio whose per-tick factor");
+    if (!c.trampleDecayPerTick.isZero())
+      nonZero(c.trampleDecayPerTick, "$.particles.blade.trampleSeconds",
+              "a recovery time whose timeStep / trampleSeconds");
+  }
 }
 }  // namespace
 
@@ -134,7 +142,9 @@ uint64_t estimateWorldBytes(const Scenario& s, ScalarKind scalar) {
     ring = (nx / m + 2 + 2 * r) * (nz / m + 2 + 2 * r) * (3 * sz + 4);
   }
   const uint64_t perPatch = 3 * sz + 3 + 3 * sz + 1;  // root, rotation+variant, derived
-  const uint64_t perParticle = 9 * sz + 3 * sz;       // p, v, anchor, displacement
+  // p, v, anchor, displacement; a trampling blade its trample level
+  const bool tramples = s.particles.model == GrassModel::Blade && !s.particles.blade.trampleSeconds.isZero();
+  const uint64_t perParticle = 9 * sz + 3 * sz + (tramples ? sz : 0);
   // Per particle row of the whole field (not only the window): the gust front's delays from the
   // first and the last row (int64 each, twice: the constants and the schedule) and the row's
   // wind acceleration.
@@ -171,6 +181,14 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
   }
   // Every exact constant the world will use (throws with a path if one cannot be formed).
   const ScenarioConstants derived = deriveConstants(s);
+  // The blade's spring is integrated explicitly (sim/particles/blade.h): stable while
+  // omega dt < 2, accurate to a few per cent of the period while omega dt <= 1.
+  const auto omegaDtSquared = mul(derived.bladeStiffnessDt, s.timeStep);
+  if (s.particles.model == GrassModel::Blade && (!omegaDtSquared || compare(*omegaDtSquared, Rational{1, 1}) > 0))
+    throw ScenarioError(s.sourceName, "$.particles.blade.frequency",
+                        "a frequency whose stiffness x timeStep^2 is at most 1 (the explicit spring's omega dt <= 1: "
+                        "about 0.16 / timeStep Hz), got " +
+                            s.particles.blade.frequency.toString() + " Hz at timeStep " + s.timeStep.toString());
   // Coordinates: every position the world can produce must fit the scalar's safe range.
   dispatchScalar(scalar, [&]<class S>() {
     const double limit = ScalarTraits<S>::maxCoordinate;
@@ -358,6 +376,11 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
     fits(s.bodies.contactHertz, "$.bodies.contactHertz");
     fits(derived.invParticleSpacing, "$.field.spacing", "1/(spacing x interpolation)");
     fits(derived.dampingPerTick, "$.particles.damping", "damping per tick");
+    if (s.particles.model == GrassModel::Blade) {
+      fits(derived.bladeStiffnessDt, "$.particles.blade.frequency", "stiffness x timeStep");
+      fits(derived.bladeDampingPerTick, "$.particles.blade.dampingRatio", "the damping per tick");
+      fits(derived.trampleDecayPerTick, "$.particles.blade.trampleSeconds", "timeStep / trampleSeconds");
+    }
     if (s.markings.enabled) {
       const auto& m = s.markings;
       check(std::fabs(d(m.centerX)), "$.markings.center[0]", "a markings centre");

@@ -1,11 +1,13 @@
 // The saved-state format, version 2 (docs/state-format.md): what saveState() writes, stateHash()
 // hashes and restoreState() reads.
 //
-//   magic "SGSTATE2" (8 bytes), then sections in this fixed order, every one always present:
+//   magic "SGSTATE2" (8 bytes), then sections in this fixed order, every one always present but TRMP:
 //     tag (4 ASCII bytes)  payload length (u64)  payload
 //   HEAD  version u32 (2), scalar u8, k u8, reserved u16 (0), scenario fingerprint u64, tick i64,
 //         particle count i64, body count u32, reserved u32 (0)
 //   PART  px, py, pz, vx, vy, vz: particle count scalars each, in window storage order
+//   TRMP  only in worlds whose grass tramples (model blade, trampleSeconds > 0): the trample
+//         level of each particle (particle count scalars, each in [0, 1]), in the same order
 //   BODY  per body: position (3), orientation w x y z (4), velocity (3), angular velocity (3)
 //         scalars, still ticks i32, flags u8 (1 asleep, 2 blade off), reserved u8 u16 (0)
 //   SPWN  spawned bodies (body scenario-bodies + n is spawn n): count u32, then per spawn
@@ -28,8 +30,9 @@ inline constexpr char kMagic[8] = {'S', 'G', 'S', 'T', 'A', 'T', 'E', '2'};
 inline constexpr uint32_t kVersion = 2;
 
 /// Section tags in their order in a state.
-enum class Section : uint8_t { Head, Particles, Bodies, Spawns, Impulses, Cuts, Window, Count };
-inline constexpr char kSectionTags[int(Section::Count)][5] = {"HEAD", "PART", "BODY", "SPWN", "CONT", "CUTS", "LODW"};
+enum class Section : uint8_t { Head, Particles, Trample, Bodies, Spawns, Impulses, Cuts, Window, Count };
+inline constexpr char kSectionTags[int(Section::Count)][5] = {"HEAD", "PART", "TRMP", "BODY",
+                                                              "SPWN", "CONT", "CUTS", "LODW"};
 
 inline constexpr uint64_t kSectionHeaderBytes = 12;  ///< tag + payload length
 inline constexpr uint64_t kHeadBytes = 40;

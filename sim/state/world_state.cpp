@@ -55,6 +55,10 @@ void World<S>::serialise(StateSink& sink) const {
   putSection(sink, Section::Particles, 6 * n * sizeof(S));
   for (const auto* v : {&particles_.px, &particles_.py, &particles_.pz, &particles_.vx, &particles_.vy, &particles_.vz})
     sink.putArray(v->data(), v->size());
+  if (!particles_.trample.empty()) {
+    putSection(sink, Section::Trample, n * sizeof(S));
+    sink.putArray(particles_.trample.data(), n);
+  }
 
   putSection(sink, Section::Bodies, bodies_.size() * (13 * sizeof(S) + kBodyExtraBytes));
   for (const RigidBody<S>& b : bodies_) {
@@ -154,6 +158,16 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
 
   Cursor particles = reader.next(Section::Particles, int64_t(6 * n * sizeof(S)));  // read last
   checkFloatValues<S>(particles, 6 * n, "particle position or velocity");
+  std::vector<S> trample;
+  if (!particles_.trample.empty()) {  // a trampling world's states have the section, others never
+    Cursor trampleSection = reader.next(Section::Trample, int64_t(n * sizeof(S)));
+    trample.resize(n);
+    const uint64_t start = trampleSection.offset();
+    trampleSection.readArray(trample.data(), n, "trample levels");
+    for (uint64_t i = 0; i < n; ++i)
+      if (!(trample[i] >= S(0) && trample[i] <= S(1)))  // false for a NaN
+        throw StateError(start + i * sizeof(S), "a trample level from 0 to 1");
+  }
 
   Cursor bodySection = reader.next(Section::Bodies, int64_t(bodyCount * (13 * sizeof(S) + kBodyExtraBytes)));
   struct BodyRecord {
@@ -273,6 +287,7 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   if (lodWindow_) fillWindow(originI, originJ, false);
   for (auto* v : {&particles_.px, &particles_.py, &particles_.pz, &particles_.vx, &particles_.vy, &particles_.vz})
     particles.readArray(v->data(), n, "particle state");
+  if (!trample.empty()) particles_.trample = std::move(trample);
   // Scenario bodies, then a copy of the template of each spawned one; the state over them.
   bodies_.resize(scenarioBodies, initialBodies_.empty() ? RigidBody<S>{} : initialBodies_[0]);
   for (size_t i = 0; i < scenarioBodies; ++i) bodies_[i] = initialBodies_[i];

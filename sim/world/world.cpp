@@ -42,7 +42,7 @@ StateError::StateError(uint64_t offset, const std::string& expected)
 template <class S>
 World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPool>(threads < 1 ? 1 : threads)) {
   configHash_ = scenarioFingerprint(s);
-  constraintMode_ = s.particles.constraintMode;
+  model_ = s.particles.model;
   const ScenarioConstants c = deriveConstants(s);
   const auto& f = s.field;
   const int k = s.particles.interpolation;
@@ -83,6 +83,9 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   particleConsts_.invDt = toS<S>(c.invDt);
   particleConsts_.dampingPerTick = toS<S>(c.dampingPerTick);
   particleConsts_.rodLength = toS<S>(s.particles.constraintLength);
+  particleConsts_.bladeStiffnessDt = toS<S>(c.bladeStiffnessDt);
+  particleConsts_.bladeDampingPerTick = toS<S>(c.bladeDampingPerTick);
+  particleConsts_.trampleDecayPerTick = toS<S>(c.trampleDecayPerTick);
 
   patchConsts_.k = k;
   for (const Rational& w : c.interpolationWeights) patchConsts_.weight.push_back(toS<S>(w));
@@ -159,6 +162,7 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   ticksToSleep_ = std::max<int32_t>(1, int32_t(*div(exact(settings::kSleepTime), s.timeStep)->roundToInt64()));
   bodyParticle_.boxNormal = s.bodies.boxParticleNormal;
   bodyParticle_.broadphase = s.bodies.particleBroadphase;
+  bodyParticle_.bladeContact = model_ == GrassModel::Blade;
   bodyParticle_.particleInvMass = toS<S>(c.invMass);
   S largest(0);
   for (const RigidBody<S>& b : bodies_) largest = maxS(largest, b.boundingRadius);
@@ -178,7 +182,7 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   patches_.variant.assign(nPatches, 0);
   patches_.cut.assign(nPatches, 0);
   patches_.tiltLevel.assign(nPatches, 0);
-  particles_.resize(size_t(grid_.size()));
+  particles_.resize(size_t(grid_.size()), model_ == GrassModel::Blade && !c.trampleDecayPerTick.isZero());
   int64_t startI = 0, startJ = 0;
   edgeRing_.configure(lattice_, s.lod.edgeSpacing, lodWindow_ ? s.lod.edgeRows : 0);
   initialVelocity_ = Vec3<S>(toS<S>(s.particles.initialVelocity[0]), toS<S>(s.particles.initialVelocity[1]),

@@ -117,7 +117,7 @@ class World final : public SimWorld {
   void followCamera(const InputVec3& camera);
 
   uint64_t configHash_ = 0;
-  ConstraintMode constraintMode_ = ConstraintMode::Thesis;
+  GrassModel model_ = GrassModel::Thesis;
   /// The fused particle pass's implementation (float and double: always the reference).
   ParticleKernel particleKernel_ = ScalarTraits<S>::isFixed ? defaultParticleKernel() : ParticleKernel::Scalar;
   GrassLattice<S> lattice_;

@@ -2,6 +2,7 @@
 // thesis section 9.2). Each stage is timed through the observer (begin and end always paired) and
 // a fault is attributed to the stage that raised it.
 #include "sim/bodies/sleep_islands.h"
+#include "sim/particles/blade.h"
 #include "sim/world/settings.h"
 #include "sim/world/world.h"
 #include "sim/world/world_rows.h"
@@ -118,13 +119,21 @@ bool World<S>::collisionStage() {
 template <class S>
 bool World<S>::integrateStage() {
   const ParticleConstants<S>& c = particleConsts_;
-  const bool pbd = constraintMode_ == ConstraintMode::Pbd;
+  const bool pbd = model_ == GrassModel::Pbd, blade = model_ == GrassModel::Blade;
+  const bool tramples = !particles_.trample.empty();
   // Integration, the rod constraint and the tip displacement run as one pass, row by row
-  // (sim/particles/particle_row.h): bit-identical to three passes, a third of the memory traffic.
-  // Its time is reported under Stage::Integrate; Stage::Constraints names a projection fault.
-  const bool moved = runParticleRows(Stage::Integrate, [&](int64_t row, int64_t b, int64_t e) {
+  // (sim/particles/particle_row.h, blade.h): bit-identical to three passes, a third of the memory
+  // traffic. Its time is reported under Stage::Integrate; Stage::Constraints names a projection
+  // fault.
+  const bool moved = runParticleRows(Stage::Integrate, [&](int64_t row, int64_t b, int64_t e) -> RowFault {
     const size_t windRow = size_t(grid_.window.latticeRow(row));  // the wind acts per lattice row
     const S dvx = rowAccel_.x[windRow], dvy = rowAccel_.y[windRow], dvz = rowAccel_.z[windRow];
+    if (blade) {  // the blade kernel is one loop (blade.h): a fault is the integration's
+      const int64_t at = tramples
+                             ? advanceBladeRow<S, true>(particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_)
+                             : advanceBladeRow<S, false>(particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_);
+      return {at, Stage::Integrate};
+    }
     const ParticleKernel kernel = particleKernel_;
     return pbd ? advanceParticleRow<S, true>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_)
                : advanceParticleRow<S, false>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_);
