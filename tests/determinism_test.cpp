@@ -31,7 +31,7 @@ nlohmann::json goldens() {
 const std::vector<GoldenCase> kGoldenCases = [] {
   std::vector<GoldenCase> cases;
   for (const char* scenario :
-       {"thesis-meadow", "hilly-meadow", "thesis-bodies", "mower-field", "lod-crossing", "blade-bodies"})
+       {"thesis-meadow", "hilly-meadow", "thesis-bodies", "mower-field", "lod-crossing", "blade-bodies", "wind-fronts"})
     for (const char* scalar : {"fx32", "fx16", "float", "double"}) cases.push_back({scenario, scalar});
   return cases;
 }();

@@ -92,6 +92,20 @@ ScenarioConstants deriveConstants(const Scenario& s) {
   // Too long a crossing is a too-slow gust, unless the spacing is over a metre (blades are
   // centimetres apart): then the spacing is the value to change (the same rule as the field reach).
   const char* crossingKey = compare(f.spacing, Rational{1, 1}) > 0 ? "$.field.spacing" : "$.wind.travelSpeed";
+  c.ticksPerParticleSpacing = ticksPerRow;
+  // A front in any direction crosses at most particlesX + particlesZ spacings; its per-column and
+  // per-row delays are Q32.32 integers (sim/wind/wind.h), which need under 2^30 ticks per spacing.
+  for (size_t g = 0; g < s.wind.schedule.size(); ++g) {
+    if (!s.wind.schedule[g].front) continue;
+    const std::string path = "$.wind.schedule[" + std::to_string(g) + "].front";
+    const auto crossing = mul(ticksPerRow, Rational::integer(c.particlesX + c.particlesZ));
+    if (compare(ticksPerRow, Rational{int64_t(1) << 30, 1}) >= 0 || !crossing ||
+        compare(*crossing, Rational{int64_t(1) << 40, 1}) >= 0)
+      throw ScenarioError(s.sourceName, crossingKey,
+                          "a gust front that crosses the field (" + path +
+                              ") in under 2^40 ticks: (particlesX + particlesZ) x field.spacing x interpolation / "
+                              "(travelSpeed x timeStep)");
+  }
   c.rowDelayTicks.resize(size_t(c.particlesZ));
   for (int64_t r = 0; r < c.particlesZ; ++r)
     c.rowDelayTicks[size_t(r)] =

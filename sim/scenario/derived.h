@@ -31,6 +31,7 @@ struct ScenarioConstants {
   std::vector<std::array<Rational, 3>> gustForcePerMass;  ///< N/kg
   std::vector<int64_t> gustTicks;                         ///< each gust's duration in ticks (>= 1)
   std::vector<int64_t> rowDelayTicks;                     ///< round(r * rowSpacing / (speed * dt)), r = 0..particlesZ-1
+  Rational ticksPerParticleSpacing;                       ///< rowSpacing / (speed * dt): a front's ticks per particle
   // heightmap terrain only
   Rational terrainInvCellSize;
   Rational terrainOriginX, terrainOriginZ;            ///< m, position of sample (0, 0)

@@ -41,6 +41,10 @@ uint64_t scenarioFingerprint(const Scenario& s) {
   for (const WindGust& g : s.wind.schedule) {
     for (const Rational& r : g.force) putRational(h, r);
     putRational(h, g.duration);
+    if (g.front) {                 // behind a tag: gusts written before fronts existed keep their fingerprint
+      putInts(h, {0x66726f6e74});  // "front"
+      for (const Rational& r : *g.front) putRational(h, r);
+    }
   }
   h.write(s.terrain.heightmap.samples.data(), s.terrain.heightmap.samples.size());  // bytes
   if (p.model == GrassModel::Blade) {  // behind a tag, as the other optional parts

@@ -106,6 +106,9 @@ struct ScriptedCommand {
 struct WindGust {
   Rational3 force;    ///< N (mass 1: m/s^2)
   Rational duration;  ///< s
+  /// The horizontal direction (x, z) its front travels in, any length but not zero; absent: along
+  /// z as wind.travel says (the thesis' rows). docs/scenario-format.md, sim/wind/wind.h.
+  std::optional<std::array<Rational, 2>> front = std::nullopt;
 };
 
 struct Scenario {

@@ -344,10 +344,21 @@ void parseWind(const Reader& r, const json& j, Scenario::Wind& w) {
     w.schedule.clear();
     for (size_t i = 0; i < s.size(); ++i) {
       const std::string q = p + ".schedule[" + std::to_string(i) + "]";
-      r.object(s[i], q, {"force", "duration"});
+      r.object(s[i], q, {"force", "duration", "front"});
       if (!s[i].contains("force")) r.fail(q + ".force", "a force [x, y, z] (missing)");
       if (!s[i].contains("duration")) r.fail(q + ".duration", "a duration in seconds (missing)");
-      w.schedule.push_back({r.vector<3>(s[i]["force"], q + ".force"), r.positive(s[i]["duration"], q + ".duration")});
+      w.schedule.push_back(
+          {r.vector<3>(s[i]["force"], q + ".force"), r.positive(s[i]["duration"], q + ".duration"), {}});
+      if (s[i].contains("front")) {
+        const auto front = r.vector<2>(s[i]["front"], q + ".front");
+        const Rational limit{1000000, 1};
+        for (const Rational& c : front)
+          if (compare(c, limit) > 0 || compare(c, Rational{-1000000, 1}) < 0)
+            r.failGot(q + ".front", "a horizontal direction [x, z] with components within +-1e6", s[i]["front"]);
+        if (front[0].isZero() && front[1].isZero())
+          r.failGot(q + ".front", "a horizontal direction [x, z], not [0, 0]", s[i]["front"]);
+        w.schedule.back().front = front;
+      }
     }
   }
 }
