@@ -89,11 +89,11 @@ double swayError(const Rational& dt, double theta0, double seconds) {
 // omega dt theta0 (its positions lag the continuous ones by half a tick: omega dt = 0.052 at
 // 0.5 Hz and 60 Hz), plus the pendulum's sin(theta) - theta (theta0^3 / 6 relative) and the
 // scalar's rounding, at most half a unit in the last place a tick (`ulp` m, per 1 m blade: rad).
-// And it must fall with dt: at a quarter of dt, to at most 0.35 of the error (0.25 for a
-// first-order method). Not in fx16: there the 960 ticks of rounding at dt = 1/240 (up to 7e-3 rad)
-// outweigh the method's 3e-4 (docs/grass-models.md: fx16 blades want dt >= 1/60).
+// And it must fall with dt: at a quarter of dt, to at most `maxRatio` of the error (0.25 for a
+// first-order method; 0.35 in fx32 and double; fx16's rounding, up to half an ulp a tick, keeps
+// it to about half: 0.6).
 template <class S>
-void expectDampedOscillator(const char* name, double ulp, bool converges) {
+void expectDampedOscillator(const char* name, double ulp, double maxRatio) {
   const double theta0 = 0.05;  // 5 cm of a 1 m blade
   const double omegaDt = 2 * std::numbers::pi * bladeTuft().particles.blade.frequency.toDouble() / 60;
   const double coarse = swayError<S>(Rational{1, 60}, theta0, 4);
@@ -101,17 +101,45 @@ void expectDampedOscillator(const char* name, double ulp, bool converges) {
   std::printf("[blade %s] 0.5 Hz, zeta 0.3, theta0 0.05 rad: max angle error %.2e rad at dt 1/60, %.2e at 1/240\n",
               name, coarse, fine);
   EXPECT_LT(coarse, omegaDt * theta0 + theta0 * theta0 * theta0 / 6 + 240 * ulp / 2) << name;
-  if (converges) {
-    EXPECT_LT(fine, 0.35 * coarse + 960 * ulp / 2) << name << ": the error does not fall with dt";
-  }
+  EXPECT_LT(fine, maxRatio * coarse) << name << ": the error does not fall with dt";
 }
-TEST(BladeModel, SmallSwayIsTheDampedOscillatorDouble) { expectDampedOscillator<double>("double", 2e-16, true); }
+TEST(BladeModel, SmallSwayIsTheDampedOscillatorDouble) { expectDampedOscillator<double>("double", 2e-16, 0.35); }
 TEST(BladeModel, SmallSwayIsTheDampedOscillatorFx32) {
-  expectDampedOscillator<Fx32>("fx32", std::ldexp(1.0, -32), true);
+  expectDampedOscillator<Fx32>("fx32", std::ldexp(1.0, -32), 0.35);
 }
 TEST(BladeModel, SmallSwayIsTheDampedOscillatorFx16) {
-  expectDampedOscillator<Fx16>("fx16", std::ldexp(1.0, -16), false);
+  expectDampedOscillator<Fx16>("fx16", std::ldexp(1.0, -16), 0.6);
 }
+
+// Without damping no blade gains energy, however short: released at 0.3 rad with dampingRatio 0,
+// the largest swing over the last 10 s of a minute stays within the release angle (a reviewer's
+// 5 cm blade at the default damping swung up to 58 deg when the rod's push on a standing blade
+// was integrated). L = 5 cm, 10 cm and 1 m; fx32, fx16, double.
+template <class S>
+void expectUndampedBladeKeepsItsAmplitude(const char* name) {
+  for (const Rational& L : {Rational{1, 20}, Rational{1, 10}, Rational{1, 1}}) {
+    Scenario s = bladeTuft();
+    s.particles.constraintLength = L;
+    s.particles.blade.dampingRatio = Rational{0, 1};
+    auto w = test::makeTyped<S>(s);
+    const double theta0 = 0.3, length = L.toDouble();
+    auto& p = w->mutableParticles();
+    p.px[0] = p.anchorX[0] + toS<S>(length * std::sin(theta0));
+    p.py[0] = p.anchorY[0] + toS<S>(length * std::cos(theta0));
+    double late = 0;
+    for (int t = 1; t <= 3600; ++t) {
+      ASSERT_TRUE(w->step(TickInput{}).ok);
+      if (t > 3000) late = std::max(late, std::fabs(tipAngle(*w)));
+    }
+    std::printf("[blade %s] undamped, L = %.2f m, released at 0.3 rad: largest swing in the last 10 s %.4f rad\n", name,
+                length, late);
+    EXPECT_LT(late, theta0 * 1.01) << name << " L = " << length;
+    EXPECT_GT(late, theta0 * 0.5) << name << " L = " << length << ": an undamped blade lost half its swing";
+  }
+}
+TEST(BladeModel, UndampedBladeKeepsItsAmplitudeFx32) { expectUndampedBladeKeepsItsAmplitude<Fx32>("fx32"); }
+TEST(BladeModel, UndampedBladeKeepsItsAmplitudeFx16) { expectUndampedBladeKeepsItsAmplitude<Fx16>("fx16"); }
+TEST(BladeModel, UndampedBladeKeepsItsAmplitudeDouble) { expectUndampedBladeKeepsItsAmplitude<double>("double"); }
 
 // Recovery after a gust, against the oscillator: back within 5 cm of upright once the envelope
 // theta0 exp(-zeta omega t) / sqrt(1 - zeta^2) is below 5 cm (theta0 0.3 rad: 1.95 s at 0.5 Hz,
@@ -328,6 +356,54 @@ void expectRestingBallHoldsTipsOut(const char* name) {
 TEST(BladeModel, RestingBallHoldsTheTipsOutFx32) { expectRestingBallHoldsTipsOut<Fx32>("fx32"); }
 TEST(BladeModel, RestingBallHoldsTheTipsOutFx16) { expectRestingBallHoldsTipsOut<Fx16>("fx16"); }
 TEST(BladeModel, RestingBallHoldsTheTipsOutDouble) { expectRestingBallHoldsTipsOut<double>("double"); }
+
+// A box dropped onto standing blades ends with no tip inside it and no hidden velocity, with either
+// box normal: pressed straight down (`up`), a standing tip would be projected back to where it was;
+// the blade bends instead (body_particles.cpp, bladeContact). A reviewer found 65 tips 0.3 m deep
+// in such a box, each carrying 10-12 m/s upward. Checked 3 s after the drop (the box at rest): no
+// tip deeper than 1 cm inside the box, and no hidden velocity: `up` presses the tips flat and
+// still (0.08 m/s at most; bound 0.5 m/s); with `nearest-face` the blades rooted at the box's
+// edges keep rising into it and being pushed out, a grind of up to 0.9 m/s over 3-15 s (bound
+// 2 m/s; before a pushed tip went straight back to its rod, the projection turned a 0.3 m push
+// into 18 m/s).
+template <class S>
+void expectBoxPressesBladesOut(BoxParticleNormal normal, const char* name) {
+  const double speedBound = normal == BoxParticleNormal::Up ? 0.5 : 2.0;
+  Scenario s = bladeBodies();
+  s.field.patchesX = s.field.patchesZ = 15;
+  s.particles.blade.trampleSeconds = Rational{0, 1};
+  s.bodies.boxParticleNormal = normal;
+  s.bodies.list = {test::box("box", test::r3(3, 3, 3, 10), test::r3(0, 2, 0))};
+  auto w = test::makeTyped<S>(s);
+  for (int t = 0; t < 180; ++t) ASSERT_TRUE(w->step(TickInput{}).ok);
+  const RigidBody<S>& box = w->bodies()[0];
+  const auto& p = w->particles();
+  double deepest = 0, fastest = 0;
+  int inside = 0;
+  for (size_t i = 0; i < p.px.size(); ++i) {
+    const Vec3<S> local = box.rotation.transpose() * (Vec3<S>(p.px[i], p.py[i], p.pz[i]) - box.position);
+    const double depth =
+        std::min({0.3 - std::fabs(d(local.x())), 0.3 - std::fabs(d(local.y())), 0.3 - std::fabs(d(local.z()))});
+    deepest = std::max(deepest, depth);
+    inside += depth > 0;
+    fastest = std::max(fastest, std::sqrt(d(p.vx[i] * p.vx[i] + p.vy[i] * p.vy[i] + p.vz[i] * p.vz[i])));
+  }
+  std::printf("[blade %s] box at rest on blades: %d tips inside, deepest %.4f m, fastest tip %.3f m/s\n", name, inside,
+              deepest, fastest);
+  EXPECT_LT(deepest, 0.01) << name;
+  EXPECT_LT(fastest, speedBound) << name;
+}
+TEST(BladeModel, BoxPressesBladesOutUpNormalFx32) { expectBoxPressesBladesOut<Fx32>(BoxParticleNormal::Up, "up fx32"); }
+TEST(BladeModel, BoxPressesBladesOutUpNormalFx16) { expectBoxPressesBladesOut<Fx16>(BoxParticleNormal::Up, "up fx16"); }
+TEST(BladeModel, BoxPressesBladesOutUpNormalDouble) {
+  expectBoxPressesBladesOut<double>(BoxParticleNormal::Up, "up double");
+}
+TEST(BladeModel, BoxPressesBladesOutNearestFaceFx32) {
+  expectBoxPressesBladesOut<Fx32>(BoxParticleNormal::NearestFace, "nearest-face fx32");
+}
+TEST(BladeModel, BoxPressesBladesOutNearestFaceDouble) {
+  expectBoxPressesBladesOut<double>(BoxParticleNormal::NearestFace, "nearest-face double");
+}
 
 // Without trampling (trampleSeconds 0) the state has no TRMP section and the blade recovers
 // from the body at once; the thesis model's state never has one.

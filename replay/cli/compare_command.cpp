@@ -297,7 +297,8 @@ void addCompareCommand(CLI::App& app, int* exitCode) {
       "Replay a recording's inputs under variant settings: ms/tick, tip and body error, first divergent tick");
   cmd->add_option("recording", o->file, "Recording (.sgr): its own settings are the reference")->required();
   cmd->add_option("--variant", o->variants,
-                  "One variant row: scalar=fx16, interp=2, broadphase=brute, body-broadphase=sap, dt=1/120, threads=2; "
+                  "One variant row: scalar=fx16, interp=2, broadphase=brute, body-broadphase=sap, dt=1/120, lod=off, "
+                  "model=blade (or thesis, pbd), threads=2; "
                   "combine with commas (scalar=fx16,interp=2). Repeatable")
       ->required()
       ->allow_extra_args(false);  // one value per --variant: `--variant interp=2 run.sgr` keeps run.sgr

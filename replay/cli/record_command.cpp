@@ -169,7 +169,7 @@ void addRecordCommand(CLI::App& app, int* exitCode) {
                   "Input-track JSON (camera keys and body commands) instead of the scenario's script");
   cmd->add_option("--variant", o->variants,
                   "Settings over the scenario: scalar=fx16, interp=2, broadphase=brute, "
-                  "body-broadphase=sap, dt=1/120 (repeatable)")
+                  "body-broadphase=sap, dt=1/120, lod=off, model=blade (repeatable)")
       ->allow_extra_args(false);  // one value per --variant: a scenario path after it stays the scenario
   cmd->add_option("--threads", o->threads, "Worker threads (the recording is identical for any count)")
       ->check(CLI::Range(1, 256));

@@ -97,7 +97,12 @@ int runScenario(const RunOptions& o) {
     j["scalar"] = scalarName(scenario.scalar);
     j["interpolation"] = counts.interpolation;
     j["threads"] = counts.threads;
-    j["kernel"] = particleKernelName(world->particleKernel());
+    // The blade model's particle pass has only the scalar reference (sim/particles/blade.h); the
+    // patch stage still runs the chosen kernel.
+    const bool blade = scenario.particles.model == GrassModel::Blade;
+    j["model"] = blade ? "blade" : scenario.particles.model == GrassModel::Pbd ? "pbd" : "thesis";
+    j["kernel"] = blade ? "scalar" : particleKernelName(world->particleKernel());
+    j["patchKernel"] = particleKernelName(world->particleKernel());
     j["counts"] = {{"patchesX", counts.patchesX},     {"patchesZ", counts.patchesZ},
                    {"patches", counts.patches()},     {"particlesX", counts.particlesX},
                    {"particlesZ", counts.particlesZ}, {"particles", counts.particles()},
@@ -122,9 +127,12 @@ int runScenario(const RunOptions& o) {
   } else {
     std::printf("scenario   %s (%s)\n", escapeControl(scenario.name).c_str(),
                 escapeControl(scenario.sourceName).c_str());
-    std::printf("scalar     %s, interpolation k=%d, %d thread%s, %s particle kernel\n", scalarName(scenario.scalar),
-                counts.interpolation, counts.threads, counts.threads == 1 ? "" : "s",
-                particleKernelName(world->particleKernel()));
+    const bool blade = scenario.particles.model == GrassModel::Blade;
+    const std::string kernelText =
+        blade ? std::string("scalar blade kernel, ") + particleKernelName(world->particleKernel()) + " patch kernel"
+              : std::string(particleKernelName(world->particleKernel())) + " particle kernel";
+    std::printf("scalar     %s, interpolation k=%d, %d thread%s, %s\n", scalarName(scenario.scalar),
+                counts.interpolation, counts.threads, counts.threads == 1 ? "" : "s", kernelText.c_str());
     std::printf(
         "patches    %" PRId64 " (%" PRId64 " x %" PRId64 "), particles %" PRId64 " (%" PRId64 " x %" PRId64 ")\n",
         counts.patches(), counts.patchesX, counts.patchesZ, counts.particles(), counts.particlesX, counts.particlesZ);

@@ -49,6 +49,7 @@ struct BodyParticleSettings {
   /// would otherwise build an inward velocity tick after tick), and is trampled when the particles
   /// carry a trample level (sim/particles/blade.h). Thesis and pbd move the position only.
   bool bladeContact = false;
+  S rodLength{};  ///< L (m), for bladeContact
 };
 
 /// Candidate ranges for every body part, in (body, part) order.

@@ -49,6 +49,7 @@ struct ParticleConstants {
   S bladeStiffnessDt{};     ///< 1/s: stiffness * dt
   S bladeDampingPerTick{};  ///< damping^dt exp(-blade damping rate * dt)
   S trampleDecayPerTick{};  ///< dt / trampleSeconds
+  S invRodLength{};         ///< 1/L (1/m)
 };
 
 }  // namespace sg

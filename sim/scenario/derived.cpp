@@ -49,6 +49,7 @@ ScenarioConstants deriveConstants(const Scenario& s) {
     c.bladeDampingRate =
         ok(mul(ok(mul(omega, p.blade.dampingRatio), b + ".dampingRatio"), Rational{2, 1}), b + ".dampingRatio");
     c.bladeStiffnessDt = ok(mul(c.bladeStiffness, s.timeStep), b + ".frequency");
+    c.invRodLength = ok(div(Rational{1, 1}, p.constraintLength), "$.particles.constraintLength");
     // exp(-rate dt) exactly as the continuous damping decays a velocity over one tick (an
     // implicit 1 / (1 + rate dt) is stable too but lets a 1 Hz, 0.3 blade ring 25 % too long by
     // 2 s): (1/e)^(rate dt), 1/e to 17 digits, by the deterministic integer pow.

@@ -21,6 +21,7 @@ struct ScenarioConstants {
   Rational bladeStiffnessDt;            ///< 1/s: stiffness * dt, the recovery's velocity change per metre of offset
   Rational bladeDampingPerTick;         ///< damping^dt exp(-dampingRate dt): both dampings, one factor
   Rational trampleDecayPerTick;         ///< dt / trampleSeconds (0: no trampling)
+  Rational invRodLength;                ///< 1/L (1/m), model blade
   Rational halfRod;                     ///< L/2 (m)
   Rational invMass;                     ///< 1/kg
   Rational jitterAmplitude;             ///< m

@@ -1,6 +1,7 @@
 // Scalar-specific checks: does this scenario fit the chosen number format and the memory?
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <sstream>
 
 #include "sim/bodies/rigid_body.h"
@@ -118,11 +119,19 @@ void checkResolution(const Scenario& s) {
   nonZero(perTick, "$.particles.damping", "a damping whose per-tick factor damping^dt stays a value");
   if (s.particles.model == GrassModel::Blade) {
     const ScenarioConstants c = deriveConstants(s);
-    nonZero(c.bladeStiffnessDt, "$.particles.blade.frequency", "a frequency whose stiffness x timeStep");
-    nonZero(c.bladeDampingPerTick, "$.particles.blade.dampingRatio", "a damping ratio whose per-tick factor");
+    nonZero(c.bladeStiffnessDt, "$.particles.blade.frequency", "a blade stiffness x timeStep (from the frequency)");
+    // exp(-4 pi dampingRatio frequency timeStep) below the scalar's resolution stops every blade
+    // dead each tick: named with its exponent, not as the 0 it rounds to.
+    if (!T::fromRational(c.bladeDampingPerTick) || *T::fromRational(c.bladeDampingPerTick) == S(0)) {
+      std::ostringstream o;
+      o.precision(4);
+      o << "a damping whose per-tick decay exp(-4 pi dampingRatio frequency timeStep) = exp(-"
+        << c.bladeDampingRate.toDouble() * s.timeStep.toDouble() << ") does not round to zero in "
+        << scalarName(T::kind) << ", got dampingRatio " << s.particles.blade.dampingRatio.toString();
+      throw ScenarioError(s.sourceName, "$.particles.blade.dampingRatio", o.str());
+    }
     if (!c.trampleDecayPerTick.isZero())
-      nonZero(c.trampleDecayPerTick, "$.particles.blade.trampleSeconds",
-              "a recovery time whose timeStep / trampleSeconds");
+      nonZero(c.trampleDecayPerTick, "$.particles.blade.trampleSeconds", "a timeStep / trampleSeconds");
   }
 }
 }  // namespace
@@ -183,12 +192,21 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
   const ScenarioConstants derived = deriveConstants(s);
   // The blade's spring is integrated explicitly (sim/particles/blade.h): stable while
   // omega dt < 2, accurate to a few per cent of the period while omega dt <= 1.
+  // The stiffness is (2 pi f)^2 - acceleration.y / L: the error names whichever term is larger
+  // (under gravity a short blade, g / L, can be what is too stiff for the step).
   const auto omegaDtSquared = mul(derived.bladeStiffnessDt, s.timeStep);
-  if (s.particles.model == GrassModel::Blade && (!omegaDtSquared || compare(*omegaDtSquared, Rational{1, 1}) > 0))
-    throw ScenarioError(s.sourceName, "$.particles.blade.frequency",
-                        "a frequency whose stiffness x timeStep^2 is at most 1 (the explicit spring's omega dt <= 1: "
-                        "about 0.16 / timeStep Hz), got " +
-                            s.particles.blade.frequency.toString() + " Hz at timeStep " + s.timeStep.toString());
+  if (s.particles.model == GrassModel::Blade && (!omegaDtSquared || compare(*omegaDtSquared, Rational{1, 1}) > 0)) {
+    const double omega = 2 * std::numbers::pi * s.particles.blade.frequency.toDouble();
+    const double lift = -s.particles.acceleration[1].toDouble() / s.particles.constraintLength.toDouble();
+    std::ostringstream o;
+    o.precision(4);
+    o << "a blade whose stiffness x timeStep^2 is at most 1 (the explicit spring's omega dt <= 1), got stiffness "
+      << derived.bladeStiffness.toDouble() << " /s^2 = (2 pi frequency)^2 = " << omega * omega
+      << " plus -acceleration.y / constraintLength = " << lift << ", at timeStep " << s.timeStep.toString()
+      << ": lower the frequency, lengthen the blade or shorten the time step";
+    throw ScenarioError(
+        s.sourceName, omega * omega >= lift ? "$.particles.blade.frequency" : "$.particles.constraintLength", o.str());
+  }
   // Coordinates: every position the world can produce must fit the scalar's safe range.
   dispatchScalar(scalar, [&]<class S>() {
     const double limit = ScalarTraits<S>::maxCoordinate;
@@ -380,6 +398,7 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
       fits(derived.bladeStiffnessDt, "$.particles.blade.frequency", "stiffness x timeStep");
       fits(derived.bladeDampingPerTick, "$.particles.blade.dampingRatio", "the damping per tick");
       fits(derived.trampleDecayPerTick, "$.particles.blade.trampleSeconds", "timeStep / trampleSeconds");
+      fits(derived.invRodLength, "$.particles.constraintLength", "1/constraintLength");
     }
     if (s.markings.enabled) {
       const auto& m = s.markings;

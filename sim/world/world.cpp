@@ -86,6 +86,7 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   particleConsts_.bladeStiffnessDt = toS<S>(c.bladeStiffnessDt);
   particleConsts_.bladeDampingPerTick = toS<S>(c.bladeDampingPerTick);
   particleConsts_.trampleDecayPerTick = toS<S>(c.trampleDecayPerTick);
+  if (model_ == GrassModel::Blade) particleConsts_.invRodLength = toS<S>(c.invRodLength);
 
   patchConsts_.k = k;
   for (const Rational& w : c.interpolationWeights) patchConsts_.weight.push_back(toS<S>(w));
@@ -163,6 +164,7 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   bodyParticle_.boxNormal = s.bodies.boxParticleNormal;
   bodyParticle_.broadphase = s.bodies.particleBroadphase;
   bodyParticle_.bladeContact = model_ == GrassModel::Blade;
+  bodyParticle_.rodLength = particleConsts_.rodLength;
   bodyParticle_.particleInvMass = toS<S>(c.invMass);
   S largest(0);
   for (const RigidBody<S>& b : bodies_) largest = maxS(largest, b.boundingRadius);
