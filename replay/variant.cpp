@@ -134,7 +134,8 @@ VariantSettings VariantSettings::resolvedFrom(const Scenario& s) {
   v.bodyBroadphase = s.bodies.bodyBroadphase;
   v.timeStep = s.timeStep;
   v.lod = s.lod.mode;
-  if (s.particles.model != GrassModel::Thesis) v.model = s.particles.model;
+  if (s.particles.model != GrassModel::Thesis || s.particles.model != s.particles.writtenModel)
+    v.model = s.particles.model;
   return v;
 }
 

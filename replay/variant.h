@@ -32,7 +32,8 @@ struct VariantSettings {
   VariantSettings over(const VariantSettings& base) const;
   void applyTo(Scenario& scenario) const;
   /// Every setting of a scenario with this variant applied (threads omitted; the model only when
-  /// it is not thesis, so recordings made before the key existed keep their resolved text).
+  /// it is not thesis or not the one the scenario text gives, so recordings made before the key
+  /// existed keep their resolved text and a thesis variant of a blade scenario replays as thesis).
   static VariantSettings resolvedFrom(const Scenario& scenario);
   /// "scalar=fx32 interp=1 broadphase=grid body-broadphase=brute dt=1/60" (set keys only).
   std::string describe() const;

@@ -290,6 +290,11 @@ TEST(Variant, ModelSwitchesTheModelAndItsDefaults) {
   EXPECT_EQ(s.particles.damping, (Rational{1, 1}));
   EXPECT_EQ(VariantSettings::resolvedFrom(s).describe(),
             "scalar=fx32 interp=1 broadphase=grid body-broadphase=brute dt=1/60 lod=off model=blade");
+  // A thesis variant of a scenario written for another model names its model.
+  Scenario written = test::thesisMeadow();
+  written.particles.writtenModel = GrassModel::Blade;
+  EXPECT_EQ(VariantSettings::resolvedFrom(written).describe(),
+            "scalar=fx32 interp=1 broadphase=grid body-broadphase=brute dt=1/60 lod=off model=thesis");
   VariantSettings::parse("model=pbd").applyTo(s);
   EXPECT_EQ(s.particles.model, GrassModel::Pbd);
   EXPECT_EQ(s.particles.acceleration, test::thesisMeadow().particles.acceleration);

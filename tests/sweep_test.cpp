@@ -356,6 +356,7 @@ TEST(SweepCliErrors, BadInputIsOneLineExit2) {
       {args(scenario, "--out", blocker + "/sub"), "--out"},
       {args(fine500, "--k", "1"), "$.timeStep"},
       {args(scenario, "--seconds", "0.01"), "--seconds"},  // under one 1/60 s step
+      {args(scenario, "--models", "rigid"), "--models"},
   };
   for (const auto& [args, mention] : cases) {
     const CliResult r = runCli(args);
@@ -369,9 +370,39 @@ TEST(SweepCliErrors, BadInputIsOneLineExit2) {
 TEST(SweepCliErrors, HelpNamesTheOptions) {
   const CliResult r = runCli("sweep --help");
   EXPECT_EQ(r.exitCode, 0);
-  for (const char* opt :
-       {"--scenarios", "--seconds", "--out", "--scalars", "--k", "--dt", "--lod", "--repeats", "--threads", "--json"})
+  for (const char* opt : {"--scenarios", "--seconds", "--out", "--scalars", "--k", "--dt", "--lod", "--models",
+                          "--repeats", "--threads", "--json"})
     EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
+}
+
+// --models sweeps each scenario once per grass model, each against its own reference (the same
+// model at double, k = 1, dt = 1/240): the reference setting of each model's rows is exact, the
+// rows name their model, and the blade rows differ from the thesis rows.
+TEST(SweepCliModels, EachModelAgainstItsOwnReference) {
+  TempDir dir;
+  const std::string scenario = dir.write("tiny.json", kTinyScenario);
+  const CliResult r = runCli("sweep --scenarios " + quote(scenario) +
+                             " --models thesis,blade --seconds 0.5 --scalars double,fx32 --k 1 --dt 1/60,1/240 "
+                             "--lod off --repeats 1 --json --out " +
+                             quote(dir.file("out")));
+  ASSERT_EQ(r.exitCode, 0) << r.describe();
+  const json doc = parseJson(r);
+  ASSERT_EQ(doc["scenarios"].size(), 2u);
+  EXPECT_EQ(doc["scenarios"][0]["model"], "thesis");
+  EXPECT_EQ(doc["scenarios"][1]["model"], "blade");
+  EXPECT_EQ(doc["scenarios"][1]["name"], "tiny-sweep [blade]");
+  ASSERT_EQ(doc["rows"].size(), 8u);  // 2 models x 2 scalars x 2 dt
+  std::map<std::string, double> tipRms;
+  for (const json& row : doc["rows"]) {
+    EXPECT_EQ(row["status"], "ok");
+    const std::string key =
+        row["model"].get<std::string>() + " " + row["scalar"].get<std::string>() + " " + row["dt"].get<std::string>();
+    tipRms[key] = row["tip_rms_m"].get<double>();
+  }
+  EXPECT_EQ(tipRms.at("thesis double 1/240"), 0.0);  // each model's reference setting is exact
+  EXPECT_EQ(tipRms.at("blade double 1/240"), 0.0);
+  EXPECT_GT(tipRms.at("blade double 1/60"), 0.0);
+  EXPECT_NE(tipRms.at("blade fx32 1/60"), tipRms.at("thesis fx32 1/60"));
 }
 
 }  // namespace

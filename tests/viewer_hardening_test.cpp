@@ -349,3 +349,22 @@ TEST(RenderHardening, AFullDiskIsAOneLineErrorAndLeavesNoPartialFrame) {
 
 }  // namespace
 }  // namespace sg
+
+namespace sg {
+namespace {
+
+// `set particles.model "blade"` on a scenario written with the model's old name (constraintMode)
+// replaces that name (both would be a scenario error) and the regenerated session runs the blade.
+TEST(ViewerHardening, SetTheGrassModelByItsNewName) {
+  if (!onPath("xvfb-run")) GTEST_SKIP() << "xvfb-run is not on PATH";
+  TempDir dir;
+  const std::string script =
+      dir.write("model.txt", "set particles.model \"blade\"\nregenerate\nframes 2\nstatus\nprint\nquit\n");
+  const CliResult v = runViewer("--script " + quote(script) + kWindow);
+  EXPECT_EQ(v.exitCode, 0) << v.describe();
+  EXPECT_NE(v.out.find("error      -"), std::string::npos) << v.out;
+  EXPECT_NE(v.out.find("state      tick 2,"), std::string::npos) << v.out;
+}
+
+}  // namespace
+}  // namespace sg

@@ -37,6 +37,7 @@ struct SweepOptions {
   std::string scenarios = kDefaultScenarios, out = "docs/results";
   std::string scalars = "fx16,fx32,float,double", ks = "1,2,3,4", dts = "1/30,1/60,1/120,1/240", lods = "off,window";
   std::string broadphases = "grid";
+  std::string models;  ///< empty: each scenario's own grass model
   double seconds = 3.0;
   int repeats = 3, threads = 1;
   bool json = false;
@@ -60,6 +61,7 @@ struct SweepAxes {
   std::vector<Rational> dts;
   std::vector<LodMode> lods;
   std::vector<ParticleBroadphase> broadphases;
+  std::vector<std::optional<GrassModel>> models;  ///< {nullopt}: each scenario's own
 };
 
 template <class T, class Parse>
@@ -101,7 +103,23 @@ SweepAxes parseAxes(const SweepOptions& o) {
                                                   if (s == "brute") return ParticleBroadphase::Brute;
                                                   return std::nullopt;
                                                 });
+  a.models = {std::nullopt};
+  if (!o.models.empty()) {
+    const auto models = parseList<GrassModel>("--models", o.models, "a comma-separated list of thesis, pbd, blade",
+                                              [](const std::string& s) -> std::optional<GrassModel> {
+                                                try {
+                                                  return VariantSettings::parse("model=" + s).model;
+                                                } catch (const std::invalid_argument&) {
+                                                  return std::nullopt;
+                                                }
+                                              });
+    a.models.assign(models.begin(), models.end());
+  }
   return a;
+}
+
+const char* grassModelName(GrassModel m) {
+  return m == GrassModel::Blade ? "blade" : m == GrassModel::Pbd ? "pbd" : "thesis";
 }
 
 /// The reference every variant is measured against: the most accurate setting of each axis.
@@ -117,7 +135,8 @@ VariantSettings referenceSettings() {
 
 /// One scenario of the sweep, with its reference run recorded and observed at the common times.
 struct SweepScenario {
-  std::string file, name;
+  std::string file, name;  ///< name: the scenario's, plus " [model]" when --models chose the model
+  GrassModel model = GrassModel::Thesis;
   Scenario reference;  ///< the scenario under the reference settings, script in reference ticks
   std::vector<sgr::EmbeddedFile> files;
   int64_t patches = 0, bodies = 0;
@@ -364,9 +383,10 @@ bool prepareOutputFolder(const std::string& dir) {
   return false;
 }
 
-nlohmann::json rowJson(const SweepRow& r, const std::string& scenario, double refDt) {
+nlohmann::json rowJson(const SweepRow& r, const std::string& scenario, GrassModel model, double refDt) {
   const int64_t first = r.summary.firstObservedTick;
   return {{"scenario", scenario},
+          {"model", grassModelName(model)},
           {"scalar", scalarName(*r.settings.scalar)},
           {"k", *r.settings.interpolation},
           {"dt", r.settings.timeStep->toString()},
@@ -407,31 +427,41 @@ int sweep(const SweepOptions& o) {
     return kExitBadInput;
   }
 
-  // Every scenario loads and takes every variant before anything runs.
+  // Every scenario loads and takes every variant before anything runs. With --models, each
+  // scenario is swept once per model, each against its own reference (the same model at the
+  // reference settings): the sweep measures each model's discretisation error, not how far two
+  // models differ (that is `simgrass compare --variant model=...`).
   std::vector<SweepScenario> scenarios;
-  for (const std::string& file : splitList(o.scenarios)) {
-    SweepScenario sc;
-    sc.file = file;
-    try {
-      if (file.empty()) throw ScenarioError("--scenarios", "$", "a comma-separated list of scenario files");
-      if (!fs::is_regular_file(file))
-        throw ScenarioError(
-            file, "$",
-            std::string("a scenario file") +
-                (o.scenarios == kDefaultScenarios ? " (run from the repository root or pass --scenarios)" : ""));
-      Scenario s = loadScenarioFile(file, &sc.files);
-      sc.name = s.name;
-      const Rational ownDt = s.timeStep;
-      ref.applyTo(s);
-      rescaleToReferenceTicks(s, ownDt, refDt, file);
-      for (ScalarKind scalar : axes.scalars) validateForScalar(s, scalar, physicalMemoryBytes());
-      sc.reference = std::move(s);
-    } catch (const ScenarioError& e) {
-      printError("simgrass sweep: %s\n", e.what());
-      return kExitBadInput;
+  for (const std::string& file : splitList(o.scenarios))
+    for (const std::optional<GrassModel>& model : axes.models) {
+      SweepScenario sc;
+      sc.file = file;
+      try {
+        if (file.empty()) throw ScenarioError("--scenarios", "$", "a comma-separated list of scenario files");
+        if (!fs::is_regular_file(file))
+          throw ScenarioError(
+              file, "$",
+              std::string("a scenario file") +
+                  (o.scenarios == kDefaultScenarios ? " (run from the repository root or pass --scenarios)" : ""));
+        Scenario s = loadScenarioFile(file, &sc.files);
+        if (model) {
+          VariantSettings chosen;
+          chosen.model = *model;
+          chosen.applyTo(s);
+        }
+        sc.model = s.particles.model;
+        sc.name = model ? s.name + " [" + grassModelName(*model) + "]" : s.name;
+        const Rational ownDt = s.timeStep;
+        ref.applyTo(s);
+        rescaleToReferenceTicks(s, ownDt, refDt, file);
+        for (ScalarKind scalar : axes.scalars) validateForScalar(s, scalar, physicalMemoryBytes());
+        sc.reference = std::move(s);
+      } catch (const ScenarioError& e) {
+        printError("simgrass sweep: %s\n", e.what());
+        return kExitBadInput;
+      }
+      scenarios.push_back(std::move(sc));
     }
-    scenarios.push_back(std::move(sc));
-  }
   if (!prepareOutputFolder(o.out)) return kExitBadInput;
   // No output may replace one of the scenarios it is computed from, nor a file one of them reads
   // (a heightmap, a mesh: `--out o3` once wrote the plot o3/h-body.png over scenario h's heightmap).
@@ -530,7 +560,7 @@ int sweep(const SweepOptions& o) {
   const double refDtS = refDt.toDouble();
   if (!writeCsv("sweep", csvPath, csvHeader, [&](std::FILE* f) {
         for (const SweepRow& r : rows) {
-          const nlohmann::json j = rowJson(r, scenarios[r.scenario].name, refDtS);
+          const nlohmann::json j = rowJson(r, scenarios[r.scenario].name, scenarios[r.scenario].model, refDtS);
           std::fprintf(f, "%s,%s,%d,%s,%s,%s,%s,%" PRId64 ",%s,%s,%s,%s,%s,%s,%s,%" PRId64 ",%s,%d,%d,%d\n",
                        csvField(scenarios[r.scenario].name).c_str(), scalarName(*r.settings.scalar),
                        *r.settings.interpolation, r.settings.timeStep->toString().c_str(),
@@ -555,11 +585,13 @@ int sweep(const SweepOptions& o) {
   for (const SweepScenario& sc : scenarios)
     scenarioList.push_back({{"file", sc.file},
                             {"name", sc.name},
+                            {"model", grassModelName(sc.model)},
                             {"patches", sc.patches},
                             {"bodies", sc.bodies},
                             {"referenceTicks", ticks},
                             {"statesCompared", sc.observed.size()}});
-  for (const SweepRow& r : rows) rowList.push_back(rowJson(r, scenarios[r.scenario].name, refDtS));
+  for (const SweepRow& r : rows)
+    rowList.push_back(rowJson(r, scenarios[r.scenario].name, scenarios[r.scenario].model, refDtS));
   doc["scenarios"] = std::move(scenarioList);
   doc["rows"] = std::move(rowList);
 
@@ -673,6 +705,9 @@ void addSweepCommand(CLI::App& app, int* exitCode) {
   cmd->add_option("--lod", o->lods, "Level-of-detail modes to sweep (subset of off,window)")->capture_default_str();
   cmd->add_option("--broadphase", o->broadphases, "Particle broad phases to sweep (grid,brute; results are identical)")
       ->capture_default_str();
+  cmd->add_option("--models", o->models,
+                  "Grass models to sweep (subset of thesis,pbd,blade), each against its own reference; "
+                  "default: each scenario's own model");
   cmd->add_option("--repeats", o->repeats, "Timed runs per variant (the cost is their median)")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();

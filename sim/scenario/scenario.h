@@ -139,6 +139,9 @@ struct Scenario {
     Rational damping{97, 100};  ///< velocity factor per second (v *= damping^dt); model blade: 1 unless given
     /// JSON "model" ("constraintMode" in files written before the blade model; thesis or pbd).
     GrassModel model = GrassModel::Thesis;
+    /// The model the scenario text gives (a variant may change `model`, not this): recordings
+    /// name the model in their variant when it is not thesis or not what the text says.
+    GrassModel writtenModel = GrassModel::Thesis;
     /// The blade model's constants (model "blade" only; docs/grass-models.md), as a user thinks of
     /// a blade: how fast it sways and how quickly that dies away, in still air. The world derives
     /// the recovery stiffness (2 pi frequency)^2 - acceleration.y / L (1/s^2) and the damping rate

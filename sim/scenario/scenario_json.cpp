@@ -302,6 +302,7 @@ void parseParticles(const Reader& r, const json& j, Scenario::Particles& s) {
   if (j.contains("constraintMode"))
     s.model = r.choice<GrassModel>(j["constraintMode"], p + ".constraintMode",
                                    {{"thesis", GrassModel::Thesis}, {"pbd", GrassModel::Pbd}});
+  s.writtenModel = s.model;
   if (s.model == GrassModel::Blade) {  // a real blade: at rest, under gravity, held up by its stiffness
     s.initialVelocity = {Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
     s.acceleration = {Rational{0, 1}, Rational{-981, 100}, Rational{0, 1}};

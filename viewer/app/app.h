@@ -47,6 +47,8 @@ struct ScenarioEdits {
   float spacing = 0.25f;
   char heightmap[512] = "";
   float cellSize = 1, maxHeight = 5;
+  int model = 0;  ///< GrassModel: 0 thesis, 1 pbd, 2 blade
+  float bladeFrequency = 0.5f, bladeDampingRatio = 0.3f, trampleSeconds = 10;
 };
 
 class App {

@@ -1,6 +1,7 @@
 // Opening files and applying panel edits: a scenario or recording replaces what runs, or the
 // edited scenario text becomes a new Session. Failures keep the old session and show the CLI's
 // one-line error (stderr and the Error window).
+#include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -60,6 +61,10 @@ void App::resetEdits() {
   e.spacing = float(s.field.spacing.toDouble());
   e.cellSize = float(s.terrain.cellSize.toDouble());
   e.maxHeight = float(s.terrain.maxHeight.toDouble());
+  e.model = int(s.particles.model);
+  e.bladeFrequency = float(s.particles.blade.frequency.toDouble());
+  e.bladeDampingRatio = float(s.particles.blade.dampingRatio.toDouble());
+  e.trampleSeconds = float(s.particles.blade.trampleSeconds.toDouble());
   std::snprintf(e.heightmap, sizeof e.heightmap, "%s", s.terrain.heightmapPath.c_str());
   edits_ = e;
 }
@@ -80,6 +85,21 @@ std::string App::editedScenarioText() const {
                                     round6(s.particles.acceleration[2].toDouble())};
   j["particles"]["constraintLength"] = round6(edits_.constraintLength);
   j["particles"]["interpolation"] = edits_.interpolation;
+  // The grass model (docs/grass-models.md) under its new name; another model than the text's
+  // starts from that model's initial velocity (the panel set its damping and acceleration).
+  static constexpr const char* kModelNames[] = {"thesis", "pbd", "blade"};
+  const int model = std::clamp(edits_.model, 0, 2);
+  j["particles"].erase("constraintMode");
+  j["particles"]["model"] = kModelNames[model];
+  if (model != int(s.particles.writtenModel))
+    j["particles"]["initialVelocity"] =
+        model == int(GrassModel::Blade) ? nlohmann::json{0, 0, 0} : nlohmann::json{0.2, 0.2, 0.2};
+  if (model == int(GrassModel::Blade))
+    j["particles"]["blade"] = {{"frequency", round6(edits_.bladeFrequency)},
+                               {"dampingRatio", round6(edits_.bladeDampingRatio)},
+                               {"trampleSeconds", round6(edits_.trampleSeconds)}};
+  else
+    j["particles"].erase("blade");
   j["bodies"]["gravity"] = {round6(s.bodies.gravity[0].toDouble()), round6(edits_.gravityY),
                             round6(s.bodies.gravity[2].toDouble())};
   j["field"]["scaleY"] = round6(edits_.scaleY);

@@ -137,8 +137,23 @@ void App::panelPhysics() {
   if (ImGui::CollapsingHeader("Physics")) {
     ImGui::SliderFloat("gust strength x", &edits_.gustScale, 0.0f, 4.0f);
     ImGui::SliderFloat("gust period x", &edits_.gustPeriodScale, 0.25f, 4.0f);
+    // The grass model: switching takes the new model's damping and acceleration (as the
+    // `model=` variant does); the blade has its own sway frequency, damping ratio and trampling.
+    static constexpr const char* kModels[] = {"thesis", "pbd", "blade"};
+    const int before = edits_.model;
+    if (ImGui::Combo("grass model", &edits_.model, kModels, 3) && (before == 2) != (edits_.model == 2)) {
+      edits_.damping = edits_.model == 2 ? 1.0f : 0.97f;
+      edits_.upAcceleration = edits_.model == 2 ? -9.81f : 1.0f;
+    }
     ImGui::SliderFloat("damping /s", &edits_.damping, 0.5f, 1.0f, "%.3f");
-    ImGui::SliderFloat("stiffness (up m/s2)", &edits_.upAcceleration, 0.0f, 5.0f);
+    if (edits_.model == 2) {
+      ImGui::SliderFloat("sway frequency Hz", &edits_.bladeFrequency, 0.05f, 5.0f);
+      ImGui::SliderFloat("damping ratio", &edits_.bladeDampingRatio, 0.0f, 2.0f);
+      ImGui::SliderFloat("trample s", &edits_.trampleSeconds, 0.0f, 60.0f);
+      ImGui::SliderFloat("acceleration y m/s2", &edits_.upAcceleration, -20.0f, 5.0f);
+    } else {
+      ImGui::SliderFloat("stiffness (up m/s2)", &edits_.upAcceleration, 0.0f, 5.0f);
+    }
     ImGui::SliderFloat("rod length m", &edits_.constraintLength, 0.2f, 3.0f);
     ImGui::SliderFloat("gravity y m/s2", &edits_.gravityY, -30.0f, 0.0f);
     if (ImGui::Button("Apply physics")) applyScenario(editedScenarioText(), false, "physics applied");

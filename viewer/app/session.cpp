@@ -186,6 +186,12 @@ void editScenarioJson(nlohmann::json* doc, const std::string& sourceName, const 
     }
   }
   *node = std::move(v);
+  // The grass model has two names (docs/scenario-format.md): setting one replaces the other, so
+  // `set particles.model "blade"` works on a scenario written with "constraintMode".
+  if (segments.size() == 2 && segments[0] == "particles" && j["particles"].is_object()) {
+    if (segments[1] == "model") j["particles"].erase("constraintMode");
+    if (segments[1] == "constraintMode") j["particles"].erase("model");
+  }
 }
 
 std::string editScenarioText(const std::string& text, const std::string& sourceName, const std::string& dotted,
