@@ -214,7 +214,10 @@ void bladeContact(ParticleArrays<S>& pa, size_t i, const Vec3<S>& before, const 
     backToTheRod(pa, i, rod);
   const Vec3<S> push = Vec3<S>(pa.px[i], pa.py[i], pa.pz[i]) - before;
   const S length = length3(push.x(), push.y(), push.z());
-  if (length == S(0)) return;
+  if (length == S(0)) {  // pinned (pressed flat, the ground below): held still
+    pa.vx[i] = pa.vy[i] = pa.vz[i] = S(0);
+    return;
+  }
   const Vec3<S> n = push / length;
   const S into = pa.vx[i] * n.x() + pa.vy[i] * n.y() + pa.vz[i] * n.z();
   if (into >= S(0)) return;

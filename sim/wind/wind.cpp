@@ -36,7 +36,11 @@ WindSchedule WindSchedule::build(const Scenario& s, const ScenarioConstants& c) 
   for (size_t g = 0; g < s.wind.schedule.size(); ++g) {
     const WindGust& spec = s.wind.schedule[g];
     Gust gust{offset, c.gustTicks[g], s.wind.travel == WindTravel::Direction && spec.force[2].num < 0};
-    if (spec.front) {
+    if (spec.front && (*spec.front)[0].isZero()) {
+      // Along z: the thesis' rows, with their exact delays (rounding K to Q32.32 could move a
+      // row whose delay is exactly half a tick to the other side).
+      gust.backward = (*spec.front)[1].isNegative();
+    } else if (spec.front) {
       // The front's ticks per particle column and row, K u, as Q32.32 (see the top of wind.h).
       const double ticksPerSpacing = c.ticksPerParticleSpacing.toDouble();
       const double x = (*spec.front)[0].toDouble(), z = (*spec.front)[1].toDouble();
@@ -100,6 +104,12 @@ void computeRowWind(const WindSchedule& w, const WindConstants<S>& c, int64_t ti
     const int64_t period = w.periodTicks;
     const int64_t nLo = std::max<int64_t>(0, int64_t(ceilDiv(top - dMax - g.durationTicks + 1, period)));
     const int64_t nHi = int64_t(floorDiv(top - dMin, period));
+    if (nHi - nLo >= columnEnd - columnBegin) {
+      // More gust periods across the row than columns (a slow front, short gusts): a cut at every
+      // column costs less than one per period, and the runs are the same.
+      for (int64_t column = columnBegin + 1; column < columnEnd; ++column) cuts.push_back(column);
+      continue;
+    }
     for (int64_t n = nLo; n <= nHi; ++n) {
       const int64_t lo = std::max(top - n * period - g.durationTicks + 1, dMin), hi = std::min(top - n * period, dMax);
       if (lo > hi) continue;

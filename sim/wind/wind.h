@@ -16,7 +16,9 @@
 // makes the smallest delay over the field 0. a and b are computed once at load in IEEE double
 // (correctly rounded divisions and square root only: the same bits on every machine); from then
 // on every delay is exact integer arithmetic, so a row's wind is runs of columns under the same
-// gusts (computeRowWind), and the runs' boundaries are found by division, not by a scan.
+// gusts (computeRowWind), and the runs' boundaries are found by division, not by a scan (by a
+// column scan only where the row spans more gust periods than it has columns). A front along
+// +-z is not swept: it is the thesis' rows with their exact delays.
 #pragma once
 
 #include <cstdint>
