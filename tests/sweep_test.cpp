@@ -403,6 +403,19 @@ TEST(SweepCliModels, EachModelAgainstItsOwnReference) {
   EXPECT_EQ(tipRms.at("blade double 1/240"), 0.0);
   EXPECT_GT(tipRms.at("blade double 1/60"), 0.0);
   EXPECT_NE(tipRms.at("blade fx32 1/60"), tipRms.at("thesis fx32 1/60"));
+  // Each scenario's behaviour on one tuft: thesis is not stationary (its hidden upward velocity
+  // stiffens it: the same gust sways it far less at 600 s), the blade is, settles after the gust
+  // within seconds and, trampled by the press, stays down (docs/grass-models.md).
+  const json& thesis = doc["scenarios"][0]["behaviour"];
+  const json& blade = doc["scenarios"][1]["behaviour"];
+  EXPECT_LT(thesis["sway_after_600_s_m"].get<double>(), 0.5 * thesis["sway_at_start_m"].get<double>()) << thesis;
+  EXPECT_GT(blade["sway_at_start_m"].get<double>(), 0.0) << blade;
+  EXPECT_NEAR(blade["sway_after_600_s_m"].get<double>(), blade["sway_at_start_m"].get<double>(), 1e-4) << blade;
+  EXPECT_GE(blade["settle_after_gust_s"].get<double>(), 0.0) << blade;
+  EXPECT_LT(blade["settle_after_gust_s"].get<double>(), 2.0) << blade;
+  EXPECT_GT(blade["down_after_press_s"].get<double>(), 3.0) << blade;  // trampled: 10 s to recover
+  EXPECT_GT(blade["settle_after_press_s"].get<double>(), blade["down_after_press_s"].get<double>()) << blade;
+  EXPECT_NE(r.out.find("behaviour"), std::string::npos);
 }
 
 }  // namespace

@@ -22,6 +22,7 @@
 #include "replay/output_file.h"
 #include "replay/progress.h"
 #include "replay/recorder.h"
+#include "replay/report/model_behaviour.h"
 #include "replay/report/pareto.h"
 #include "replay/report/plot.h"
 #include "replay/scenario_files.h"
@@ -137,7 +138,8 @@ VariantSettings referenceSettings() {
 struct SweepScenario {
   std::string file, name;  ///< name: the scenario's, plus " [model]" when --models chose the model
   GrassModel model = GrassModel::Thesis;
-  Scenario reference;  ///< the scenario under the reference settings, script in reference ticks
+  ModelBehaviour behaviour;  ///< one tuft of the scenario under its model (report/model_behaviour.h)
+  Scenario reference;        ///< the scenario under the reference settings, script in reference ticks
   std::vector<sgr::EmbeddedFile> files;
   int64_t patches = 0, bodies = 0;
   std::unique_ptr<sgr::Recording> recording;  ///< the reference's inputs
@@ -450,6 +452,7 @@ int sweep(const SweepOptions& o) {
           chosen.applyTo(s);
         }
         sc.model = s.particles.model;
+        sc.behaviour = measureModelBehaviour(s);
         sc.name = model ? s.name + " [" + grassModelName(*model) + "]" : s.name;
         const Rational ownDt = s.timeStep;
         ref.applyTo(s);
@@ -586,6 +589,12 @@ int sweep(const SweepOptions& o) {
     scenarioList.push_back({{"file", sc.file},
                             {"name", sc.name},
                             {"model", grassModelName(sc.model)},
+                            {"behaviour",
+                             {{"sway_at_start_m", sc.behaviour.swayStart},
+                              {"sway_after_600_s_m", sc.behaviour.swayLate},
+                              {"settle_after_gust_s", sc.behaviour.settleAfterGust},
+                              {"settle_after_press_s", sc.behaviour.settleAfterPress},
+                              {"down_after_press_s", sc.behaviour.downAfterPress}}},
                             {"patches", sc.patches},
                             {"bodies", sc.bodies},
                             {"referenceTicks", ticks},
@@ -654,6 +663,13 @@ int sweep(const SweepOptions& o) {
       const SweepScenario& sc = scenarios[s];
       std::printf("\n%s (%s): %" PRId64 " patches, %" PRId64 " bodies\n", escapeControl(sc.name).c_str(),
                   escapeControl(sc.file).c_str(), sc.patches, sc.bodies);
+      const ModelBehaviour& b = sc.behaviour;
+      auto seconds = [](double v) { return v < 0 ? std::string("> 190 s") : std::to_string(v).substr(0, 5) + " s"; };
+      std::printf(
+          "behaviour  %s model, one tuft: its strongest gust sways it %.3f m at 0 s and %.3f m at 600 s; "
+          "back within 5 cm %s after it, %s after a press to 70 deg; down %s\n",
+          grassModelName(sc.model), b.swayStart, b.swayLate, seconds(b.settleAfterGust).c_str(),
+          seconds(b.settleAfterPress).c_str(), seconds(b.downAfterPress).c_str());
       std::printf("%-28s %10s %12s %11s %11s %11s %9s  %s\n", "variant", "ms/tick", "ms/sim s", "tip rms m",
                   "tip max m", "body pos m", "diverges", "status");
       for (const SweepRow& r : rows) {

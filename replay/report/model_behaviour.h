@@ -1,0 +1,24 @@
+// How a grass model behaves, measured on one tuft of a scenario (issue 16's behaviour metrics, the
+// sweep prints them per scenario and model): stationarity (the same gust at the start and ten
+// minutes in), how fast a tuft settles after a gust and after a body lets it go, and how long a
+// pressed tuft stays down. docs/grass-models.md.
+#pragma once
+
+#include "sim/scenario/scenario.h"
+
+namespace sg {
+
+struct ModelBehaviour {
+  double swayStart = 0;          ///< m: largest tip offset under the gust when it comes at t = 0
+  double swayLate = 0;           ///< m: the same gust coming 600 s into the run
+  double settleAfterGust = -1;   ///< s after the gust ends until the tip stays within 5 cm (-1: not in 200 s)
+  double settleAfterPress = -1;  ///< s after a tip pressed to 70 degrees is let go until it stays within 5 cm
+  double downAfterPress = 0;     ///< s the pressed tip stays below half its rod's height (trampling)
+};
+
+/// One tuft of `scenario` (its particles, grass model and time step, starting at rest; flat ground,
+/// no bodies, the scenario's strongest gust alone), in double. A press sets the tip to 70 degrees at rest, and
+/// trampled when the model tramples. Throws ScenarioError when the scenario does not validate.
+ModelBehaviour measureModelBehaviour(const Scenario& scenario);
+
+}  // namespace sg
