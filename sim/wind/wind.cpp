@@ -67,12 +67,14 @@ WindSchedule WindSchedule::build(const Scenario& s, const ScenarioConstants& c) 
 
 template <class S>
 void computeRowAcceleration(const WindSchedule& schedule, const WindConstants<S>& c, int64_t tick,
-                            RowAccelerationDt<S>* out) {
+                            RowAccelerationDt<S>* out, int64_t rowBegin, int64_t rowEnd) {
   const int64_t rows = int64_t(schedule.delayFromFirstRow.size());
   out->x.resize(size_t(rows));
   out->y.resize(size_t(rows));
   out->z.resize(size_t(rows));
-  for (int64_t r = 0; r < rows; ++r) {
+  rowBegin = std::clamp<int64_t>(rowBegin, 0, rows);
+  rowEnd = rowEnd < 0 ? rows : std::clamp<int64_t>(rowEnd, rowBegin, rows);
+  for (int64_t r = rowBegin; r < rowEnd; ++r) {
     S ax = c.accX, ay = c.accY, az = c.accZ;
     for (size_t g = 0; g < schedule.gusts.size(); ++g) {
       if (schedule.gusts[g].swept || !schedule.active(g, r, tick)) continue;
@@ -133,14 +135,14 @@ void computeRowWind(const WindSchedule& w, const WindConstants<S>& c, int64_t ti
   }
 }
 
-template void computeRowAcceleration(const WindSchedule&, const WindConstants<Fx32>&, int64_t,
-                                     RowAccelerationDt<Fx32>*);
-template void computeRowAcceleration(const WindSchedule&, const WindConstants<Fx16>&, int64_t,
-                                     RowAccelerationDt<Fx16>*);
+template void computeRowAcceleration(const WindSchedule&, const WindConstants<Fx32>&, int64_t, RowAccelerationDt<Fx32>*,
+                                     int64_t, int64_t);
+template void computeRowAcceleration(const WindSchedule&, const WindConstants<Fx16>&, int64_t, RowAccelerationDt<Fx16>*,
+                                     int64_t, int64_t);
 template void computeRowAcceleration(const WindSchedule&, const WindConstants<float>&, int64_t,
-                                     RowAccelerationDt<float>*);
+                                     RowAccelerationDt<float>*, int64_t, int64_t);
 template void computeRowAcceleration(const WindSchedule&, const WindConstants<double>&, int64_t,
-                                     RowAccelerationDt<double>*);
+                                     RowAccelerationDt<double>*, int64_t, int64_t);
 #define SG_INSTANTIATE_ROW_WIND(S)                                                                               \
   template void computeRowWind(const WindSchedule&, const WindConstants<S>&, int64_t, int64_t, int64_t, int64_t, \
                                std::vector<WindRun<S>>*);

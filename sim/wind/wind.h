@@ -89,10 +89,13 @@ struct WindConstants {
   S dt{};
 };
 
-/// Per-row velocity increments of the row-uniform gusts (all of the wind when rowUniform()).
+/// Per-row velocity increments of the row-uniform gusts (all of the wind when rowUniform()), for
+/// the field's particle rows [rowBegin, rowEnd) (rowEnd < 0: to the last); *out holds every row of
+/// the field, the others untouched. A level-of-detail window computes only its own rows (walking
+/// every row of a 1,048,576-row field was 7-9 ms of a 10 ms tick).
 template <class S>
 void computeRowAcceleration(const WindSchedule& schedule, const WindConstants<S>& c, int64_t tick,
-                            RowAccelerationDt<S>* out);
+                            RowAccelerationDt<S>* out, int64_t rowBegin = 0, int64_t rowEnd = -1);
 
 /// Columns [begin, end) of one particle row under the same wind: (a + F/m) dt.
 template <class S>

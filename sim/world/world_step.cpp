@@ -105,7 +105,8 @@ bool World<S>::inputStage(const TickInput& input) {
 
 template <class S>
 bool World<S>::windStage() {
-  computeRowAcceleration(windSchedule_, windConsts_, tick_, &rowAccel_);
+  // The window's rows only (with the level of detail off, the window is the field).
+  computeRowAcceleration(windSchedule_, windConsts_, tick_, &rowAccel_, grid_.window.originJ, grid_.window.endJ());
   const uint32_t faults = takeFixedFaults();
   return faults == 0 || failWith(Stage::Wind, faults);
 }
