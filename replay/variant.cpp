@@ -11,9 +11,7 @@ namespace {
 }
 const char* broadphaseName(ParticleBroadphase b) { return b == ParticleBroadphase::Brute ? "brute" : "grid"; }
 const char* bodyBroadphaseName(BodyBroadphase b) { return b == BodyBroadphase::SweepAndPrune ? "sap" : "brute"; }
-const char* modelName(GrassModel m) {
-  return m == GrassModel::Blade ? "blade" : m == GrassModel::Pbd ? "pbd" : "thesis";
-}
+
 }  // namespace
 
 VariantSettings VariantSettings::parse(const std::string& text) {
@@ -148,7 +146,7 @@ std::string VariantSettings::describe() const {
   if (bodyBroadphase) add(std::string("body-broadphase=") + bodyBroadphaseName(*bodyBroadphase));
   if (timeStep) add("dt=" + timeStep->toString());
   if (lod) add(std::string("lod=") + (*lod == LodMode::Window ? "window" : "off"));
-  if (model) add(std::string("model=") + modelName(*model));
+  if (model) add(std::string("model=") + grassModelName(*model));
   if (threads) add("threads=" + std::to_string(*threads));
   return out;
 }

@@ -100,7 +100,7 @@ int runScenario(const RunOptions& o) {
     // The blade model's particle pass has only the scalar reference (sim/particles/blade.h); the
     // patch stage still runs the chosen kernel.
     const bool blade = scenario.particles.model == GrassModel::Blade;
-    j["model"] = blade ? "blade" : scenario.particles.model == GrassModel::Pbd ? "pbd" : "thesis";
+    j["model"] = grassModelName(scenario.particles.model);
     j["kernel"] = blade ? "scalar" : particleKernelName(world->particleKernel());
     j["patchKernel"] = particleKernelName(world->particleKernel());
     j["counts"] = {{"patchesX", counts.patchesX},     {"patchesZ", counts.patchesZ},

@@ -119,10 +119,6 @@ SweepAxes parseAxes(const SweepOptions& o) {
   return a;
 }
 
-const char* grassModelName(GrassModel m) {
-  return m == GrassModel::Blade ? "blade" : m == GrassModel::Pbd ? "pbd" : "thesis";
-}
-
 /// The reference every variant is measured against: the most accurate setting of each axis.
 VariantSettings referenceSettings() {
   VariantSettings r;

@@ -25,6 +25,10 @@ enum class GrassModel : uint8_t {
   Pbd,     ///< position-based dynamics: velocity recomputed from the corrected position
   Blade,   ///< a stiff blade: recovery toward the upright rest pose, gravity, trampling
 };
+/// "thesis", "pbd" or "blade": the JSON name of a grass model.
+inline const char* grassModelName(GrassModel m) {
+  return m == GrassModel::Blade ? "blade" : m == GrassModel::Pbd ? "pbd" : "thesis";
+}
 /// Which row a gust reaches first.
 enum class WindTravel : uint8_t {
   Direction,  ///< a gust enters from the side it blows from (+z gusts: first row first)

@@ -87,10 +87,9 @@ std::string App::editedScenarioText() const {
   j["particles"]["interpolation"] = edits_.interpolation;
   // The grass model (docs/grass-models.md) under its new name; another model than the text's
   // starts from that model's initial velocity (the panel set its damping and acceleration).
-  static constexpr const char* kModelNames[] = {"thesis", "pbd", "blade"};
   const int model = std::clamp(edits_.model, 0, 2);
   j["particles"].erase("constraintMode");
-  j["particles"]["model"] = kModelNames[model];
+  j["particles"]["model"] = grassModelName(GrassModel(model));
   if (model != int(s.particles.writtenModel))
     j["particles"]["initialVelocity"] =
         model == int(GrassModel::Blade) ? nlohmann::json{0, 0, 0} : nlohmann::json{0.2, 0.2, 0.2};
