@@ -10,6 +10,11 @@
 
 namespace sg {
 
+/// Milliseconds of wall time since t0 (the tools' timings: compare, sweep).
+inline double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
 class StageClock final : public StageObserver {
  public:
   void stageBegin(Stage s) override { begin_[size_t(s)] = std::chrono::steady_clock::now(); }

@@ -164,7 +164,10 @@ const std::vector<std::string> kColumns{"scenario",
                                         "status",
                                         "pareto",
                                         "pareto_tip_max",
-                                        "pareto_body"};
+                                        "pareto_body",
+                                        "model_error_rms_m",
+                                        "model_error_max_m",
+                                        "pareto_model"};
 
 std::vector<std::map<std::string, std::string>> readCsv(const std::string& path) {
   std::istringstream in(readFile(path));
@@ -278,8 +281,10 @@ TEST_F(SweepCli, ReferenceRowIsExactAndOthersDiffer) {
 TEST_F(SweepCli, ParetoFlagsMatchAnIndependentCheck) {
   ASSERT_EQ(result_->exitCode, 0) << result_->describe();
   const json rows = parseJson(*result_)["rows"];
-  const std::pair<const char*, const char*> measures[] = {
-      {"tip_rms_m", "pareto"}, {"tip_max_m", "pareto_tip_max"}, {"body_pos_max_m", "pareto_body"}};
+  const std::pair<const char*, const char*> measures[] = {{"tip_rms_m", "pareto"},
+                                                          {"tip_max_m", "pareto_tip_max"},
+                                                          {"body_pos_max_m", "pareto_body"},
+                                                          {"model_error_rms_m", "pareto_model"}};
   for (const auto& [error, flag] : measures) {
     int onFront = 0;
     for (const json& a : rows) {
@@ -300,8 +305,8 @@ TEST_F(SweepCli, ParetoFlagsMatchAnIndependentCheck) {
 TEST_F(SweepCli, PlotsDecode) {
   ASSERT_EQ(result_->exitCode, 0) << result_->describe();
   const json doc = parseJson(*result_);
-  ASSERT_EQ(doc["plots"].size(), 3u);
-  for (const char* kind : {"tip-rms", "tip-max", "body"}) {
+  ASSERT_EQ(doc["plots"].size(), 4u);
+  for (const char* kind : {"tip-rms", "tip-max", "body", "model-error"}) {
     const std::string path = dir_->file(std::string("out/tiny-sweep-") + kind + ".png");
     int w = 0, h = 0, n = 0;
     unsigned char* data = stbi_load(path.c_str(), &w, &h, &n, 3);
@@ -416,6 +421,22 @@ TEST(SweepCliModels, EachModelAgainstItsOwnReference) {
   EXPECT_GT(blade["down_after_press_s"].get<double>(), 3.0) << blade;  // trampled: 10 s to recover
   EXPECT_GT(blade["settle_after_press_s"].get<double>(), blade["down_after_press_s"].get<double>()) << blade;
   EXPECT_NE(r.out.find("behaviour"), std::string::npos);
+  // Each row's model error against the reference blade (replay/report/reference_blade.h): it
+  // depends on the model and dt only, and the blade model is far closer to the truth than the
+  // thesis model (tests/reference_blade_test.cpp measures all three).
+  std::map<std::string, double> modelError;
+  for (const json& row : doc["rows"]) {
+    const std::string key = row["model"].get<std::string>() + " " + row["dt"].get<std::string>();
+    const double e = row["model_error_rms_m"].get<double>();
+    EXPECT_GT(e, 0.0) << row;
+    EXPECT_GE(row["model_error_max_m"].get<double>(), e) << row;
+    if (modelError.count(key)) {
+      EXPECT_EQ(modelError[key], e) << key;  // the same for every scalar
+    }
+    modelError[key] = e;
+  }
+  EXPECT_LT(modelError.at("blade 1/60"), 0.5 * modelError.at("thesis 1/60"));
+  EXPECT_LT(modelError.at("blade 1/240"), 0.5 * modelError.at("thesis 1/240"));
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "replay/lockstep.h"
 #include "replay/progress.h"
 #include "replay/scenario_files.h"
+#include "replay/stage_clock.h"
 
 namespace sg {
 namespace {
@@ -44,10 +45,6 @@ struct Row {
     return summary.firstObservedTick < 0 ? "same observations" : "differs";
   }
 };
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// The reference (the recording under its own settings) verified against the recorded hashes.
 struct Reference {

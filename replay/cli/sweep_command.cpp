@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -26,6 +27,7 @@
 #include "replay/report/pareto.h"
 #include "replay/report/plot.h"
 #include "replay/scenario_files.h"
+#include "replay/stage_clock.h"
 
 namespace sg {
 namespace {
@@ -135,7 +137,10 @@ struct SweepScenario {
   std::string file, name;  ///< name: the scenario's, plus " [model]" when --models chose the model
   GrassModel model = GrassModel::Thesis;
   ModelBehaviour behaviour;  ///< one tuft of the scenario under its model (report/model_behaviour.h)
-  Scenario reference;        ///< the scenario under the reference settings, script in reference ticks
+  /// The model's error against the reference blade (report/reference_blade.h) at each swept dt
+  /// (by its text; NaN where the one tuft does not validate at that step).
+  std::map<std::string, ModelError> modelError;
+  Scenario reference;  ///< the scenario under the reference settings, script in reference ticks
   std::vector<sgr::EmbeddedFile> files;
   int64_t patches = 0, bodies = 0;
   std::unique_ptr<sgr::Recording> recording;  ///< the reference's inputs
@@ -149,9 +154,10 @@ struct SweepRow {
   int64_t steps = 0;          ///< own ticks per run
   std::vector<double> runMs;  ///< stepping time of each repeat, ms
   DivergenceSummary summary;
-  std::string fault;  ///< empty: ran to the end
+  ModelError modelError;  ///< the scenario's model at this row's dt against the reference blade
+  std::string fault;      ///< empty: ran to the end
   double msPerTick = 0, msPerSimSecond = 0;
-  bool pareto = false, paretoTipMax = false, paretoBody = false;
+  bool pareto = false, paretoTipMax = false, paretoBody = false, paretoModel = false;
 
   double dtSeconds() const { return settings.timeStep->toDouble(); }
   std::string status() const { return fault.empty() ? "ok" : "fault: " + fault; }
@@ -222,10 +228,6 @@ void runReference(SweepScenario& sc, int64_t ticks, int64_t interval, int thread
   } catch (const sgr::RecordingError& e) {
     throw std::runtime_error(e.what());
   }
-}
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 /// One run of a variant over the reference's inputs, timed (stepping only); when `measure`,
@@ -311,7 +313,7 @@ plot::Marker kMarker(int k) {
 /// One plot: cost (ms per simulated second) against one error of the rows of one scenario.
 plot::ScatterPlot errorPlot(const SweepScenario& sc, const std::vector<const SweepRow*>& rows, const SweepAxes& axes,
                             const std::string& what, const std::string& unit, double (*error)(const SweepRow&),
-                            bool SweepRow::*onFront, int repeats, int threads) {
+                            bool SweepRow::*onFront, int repeats, int threads, bool modelError) {
   plot::ScatterPlot p;
   p.title = sc.name + ": cost against " + what;
   p.xLabel = "ms of wall time per simulated second (log)";
@@ -355,9 +357,11 @@ plot::ScatterPlot errorPlot(const SweepScenario& sc, const std::vector<const Swe
   std::snprintf(buf, sizeof buf, "An error of 0 (identical to the reference) is plotted at %s %s.",
                 plot::tickLabel(floor).c_str(), unit.c_str());
   p.notes.push_back(buf);
-  p.notes.push_back(
-      "Reference: double, k = 1, dt = 1/240, LOD off. Pareto points are ringed and labelled: scalar, k, dt, win = LOD "
-      "window.");
+  p.notes.push_back(modelError
+                        ? "Model error: one tuft's tip RMS against the reference blade (8 segments, double; "
+                          "docs/grass-models.md), 30 s of wind and a press; it depends on the model and dt only."
+                        : "Reference: double, k = 1, dt = 1/240, LOD off. Pareto points are ringed and labelled: "
+                          "scalar, k, dt, win = LOD window.");
   std::snprintf(buf, sizeof buf, "Cost: median of %d run%s, %d thread%s; errors over %zu common times.", repeats,
                 repeats == 1 ? "" : "s", threads, threads == 1 ? "" : "s", sc.observed.size());
   p.notes.push_back(buf);
@@ -403,7 +407,10 @@ nlohmann::json rowJson(const SweepRow& r, const std::string& scenario, GrassMode
           {"status", r.status()},
           {"pareto", r.pareto},
           {"pareto_tip_max", r.paretoTipMax},
-          {"pareto_body", r.paretoBody}};
+          {"pareto_body", r.paretoBody},
+          {"model_error_rms_m", r.modelError.tipRms},
+          {"model_error_max_m", r.modelError.tipMax},
+          {"pareto_model", r.paretoModel}};
 }
 
 int sweep(const SweepOptions& o) {
@@ -449,6 +456,14 @@ int sweep(const SweepOptions& o) {
         }
         sc.model = s.particles.model;
         sc.behaviour = measureModelBehaviour(s);
+        for (const Rational& dt : axes.dts) {
+          ModelError e{NAN, NAN, 0};
+          try {
+            e = measureModelError(s, dt);
+          } catch (const ScenarioError&) {  // the variant at this dt faults too, and says why
+          }
+          sc.modelError[dt.toString()] = e;
+        }
         sc.name = model ? s.name + " [" + grassModelName(*model) + "]" : s.name;
         const Rational ownDt = s.timeStep;
         ref.applyTo(s);
@@ -475,9 +490,9 @@ int sweep(const SweepOptions& o) {
   };
   for (const char* name : {"sweep.csv", "sweep.json"})
     if (overwritesScenario((fs::path(o.out) / name).string())) return kExitBadInput;
-  // The plots' names too, before the run (not after an hour of it): three per scenario, named by
+  // The plots' names too, before the run (not after an hour of it): four per scenario, named by
   // its slug (numbered when two scenarios share one).
-  static constexpr const char* kPlotSuffixes[] = {"tip-rms", "tip-max", "body"};
+  static constexpr const char* kPlotSuffixes[] = {"tip-rms", "tip-max", "body", "model-error"};
   std::vector<std::string> plotBase;
   for (size_t s = 0; s < scenarios.size(); ++s) {
     std::string base = slug(scenarios[s].name);
@@ -498,6 +513,7 @@ int sweep(const SweepOptions& o) {
               r.scenario = s;
               r.settings.scalar = scalar, r.settings.interpolation = k, r.settings.timeStep = dt;
               r.settings.lod = lod, r.settings.broadphase = bp;
+              r.modelError = scenarios[s].modelError.at(dt.toString());
               rows.push_back(std::move(r));
             }
 
@@ -534,7 +550,7 @@ int sweep(const SweepOptions& o) {
   }
   for (size_t s = 0; s < scenarios.size(); ++s) {
     std::vector<size_t> idx;
-    std::vector<double> cost, tipRms, tipMax, body;
+    std::vector<double> cost, tipRms, tipMax, body, model;
     std::vector<bool> ok;
     for (size_t i = 0; i < rows.size(); ++i) {
       if (rows[i].scenario != s) continue;
@@ -543,33 +559,37 @@ int sweep(const SweepOptions& o) {
       tipRms.push_back(rows[i].summary.tipRms());
       tipMax.push_back(rows[i].summary.tipMax);
       body.push_back(rows[i].summary.bodyPosMax);
+      model.push_back(rows[i].modelError.tipRms);
       ok.push_back(rows[i].fault.empty());
     }
     const std::vector<bool> a = paretoFront(cost, tipRms, ok), b = paretoFront(cost, tipMax, ok),
-                            c = paretoFront(cost, body, ok);
+                            c = paretoFront(cost, body, ok), d = paretoFront(cost, model, ok);
     for (size_t j = 0; j < idx.size(); ++j)
-      rows[idx[j]].pareto = a[j], rows[idx[j]].paretoTipMax = b[j], rows[idx[j]].paretoBody = c[j];
+      rows[idx[j]].pareto = a[j], rows[idx[j]].paretoTipMax = b[j], rows[idx[j]].paretoBody = c[j],
+      rows[idx[j]].paretoModel = d[j];
   }
 
   // sweep.csv and sweep.json.
   const std::string csvPath = (fs::path(o.out) / "sweep.csv").string();
   const std::string csvHeader =
       "scenario,scalar,k,dt,dt_s,lod,broadphase,steps,ms_per_tick,ms_per_simulated_second,tip_rms_m,tip_max_m,"
-      "body_pos_max_m,body_angle_max_rad,first_divergent_time,states_compared,status,pareto,pareto_tip_max,pareto_body";
+      "body_pos_max_m,body_angle_max_rad,first_divergent_time,states_compared,status,pareto,pareto_tip_max,pareto_body,"
+      "model_error_rms_m,model_error_max_m,pareto_model";
   const double refDtS = refDt.toDouble();
   if (!writeCsv("sweep", csvPath, csvHeader, [&](std::FILE* f) {
         for (const SweepRow& r : rows) {
           const nlohmann::json j = rowJson(r, scenarios[r.scenario].name, scenarios[r.scenario].model, refDtS);
-          std::fprintf(f, "%s,%s,%d,%s,%s,%s,%s,%" PRId64 ",%s,%s,%s,%s,%s,%s,%s,%" PRId64 ",%s,%d,%d,%d\n",
-                       csvField(scenarios[r.scenario].name).c_str(), scalarName(*r.settings.scalar),
-                       *r.settings.interpolation, r.settings.timeStep->toString().c_str(),
-                       csvNumber(r.dtSeconds()).c_str(), j["lod"].get<std::string>().c_str(),
-                       j["broadphase"].get<std::string>().c_str(), r.steps, csvNumber(r.msPerTick).c_str(),
-                       csvNumber(r.msPerSimSecond).c_str(), csvNumber(r.summary.tipRms()).c_str(),
-                       csvNumber(r.summary.tipMax).c_str(), csvNumber(r.summary.bodyPosMax).c_str(),
-                       csvNumber(r.summary.bodyAngleMax).c_str(),
-                       csvNumber(j["first_divergent_time"].get<double>()).c_str(), r.summary.ticks,
-                       csvField(r.status()).c_str(), r.pareto ? 1 : 0, r.paretoTipMax ? 1 : 0, r.paretoBody ? 1 : 0);
+          std::fprintf(
+              f, "%s,%s,%d,%s,%s,%s,%s,%" PRId64 ",%s,%s,%s,%s,%s,%s,%s,%" PRId64 ",%s,%d,%d,%d,%s,%s,%d\n",
+              csvField(scenarios[r.scenario].name).c_str(), scalarName(*r.settings.scalar), *r.settings.interpolation,
+              r.settings.timeStep->toString().c_str(), csvNumber(r.dtSeconds()).c_str(),
+              j["lod"].get<std::string>().c_str(), j["broadphase"].get<std::string>().c_str(), r.steps,
+              csvNumber(r.msPerTick).c_str(), csvNumber(r.msPerSimSecond).c_str(),
+              csvNumber(r.summary.tipRms()).c_str(), csvNumber(r.summary.tipMax).c_str(),
+              csvNumber(r.summary.bodyPosMax).c_str(), csvNumber(r.summary.bodyAngleMax).c_str(),
+              csvNumber(j["first_divergent_time"].get<double>()).c_str(), r.summary.ticks, csvField(r.status()).c_str(),
+              r.pareto ? 1 : 0, r.paretoTipMax ? 1 : 0, r.paretoBody ? 1 : 0, csvNumber(r.modelError.tipRms).c_str(),
+              csvNumber(r.modelError.tipMax).c_str(), r.paretoModel ? 1 : 0);
         }
       }))
     return kExitBadInput;
@@ -600,7 +620,7 @@ int sweep(const SweepOptions& o) {
   doc["scenarios"] = std::move(scenarioList);
   doc["rows"] = std::move(rowList);
 
-  // The plots: three per scenario.
+  // The plots: four per scenario.
   std::vector<std::string> pngs;
   for (size_t s = 0; s < scenarios.size(); ++s) {
     std::vector<const SweepRow*> mine;
@@ -621,14 +641,16 @@ int sweep(const SweepOptions& o) {
          &SweepRow::paretoTipMax},
         {kPlotSuffixes[2], "body position max error", "m", [](const SweepRow& r) { return r.summary.bodyPosMax; },
          &SweepRow::paretoBody},
+        {kPlotSuffixes[3], "model error", "m", [](const SweepRow& r) { return r.modelError.tipRms; },
+         &SweepRow::paretoModel},
     };
     for (const Kind& k : kinds) {
       const std::string path = (fs::path(o.out) / (base + "-" + k.suffix + ".png")).string();
       std::string error;
-      if (!plot::writePng(
-              path,
-              plot::render(errorPlot(scenarios[s], mine, axes, k.what, k.unit, k.error, k.front, o.repeats, o.threads)),
-              &error)) {
+      if (!plot::writePng(path,
+                          plot::render(errorPlot(scenarios[s], mine, axes, k.what, k.unit, k.error, k.front, o.repeats,
+                                                 o.threads, k.front == &SweepRow::paretoModel)),
+                          &error)) {
         printError("simgrass sweep: %s\n", error.c_str());
         return kExitBadInput;
       }
@@ -666,8 +688,8 @@ int sweep(const SweepOptions& o) {
           "back within 5 cm %s after it, %s after a press to 70 deg; down %s\n",
           grassModelName(sc.model), b.swayStart, b.swayLate, seconds(b.settleAfterGust).c_str(),
           seconds(b.settleAfterPress).c_str(), seconds(b.downAfterPress).c_str());
-      std::printf("%-28s %10s %12s %11s %11s %11s %9s  %s\n", "variant", "ms/tick", "ms/sim s", "tip rms m",
-                  "tip max m", "body pos m", "diverges", "status");
+      std::printf("%-28s %10s %12s %11s %11s %11s %9s %11s  %s\n", "variant", "ms/tick", "ms/sim s", "tip rms m",
+                  "tip max m", "body pos m", "diverges", "model err m", "status");
       for (const SweepRow& r : rows) {
         if (r.scenario != s) continue;
         const int64_t first = r.summary.firstObservedTick;
@@ -676,17 +698,19 @@ int sweep(const SweepOptions& o) {
           std::snprintf(diverges, sizeof diverges, "never");
         else
           std::snprintf(diverges, sizeof diverges, "%.3g s", double(first) * refDtS);
-        std::printf("%-28s %10.3f %12.1f %11s %11s %11s %9s  %s%s\n", r.label().c_str(), r.msPerTick, r.msPerSimSecond,
-                    shortNumber(r.summary.tipRms()).c_str(), shortNumber(r.summary.tipMax).c_str(),
-                    shortNumber(r.summary.bodyPosMax).c_str(), diverges, r.status().c_str(),
-                    r.pareto ? "  * pareto" : "");
+        std::printf("%-28s %10.3f %12.1f %11s %11s %11s %9s %11s  %s%s\n", r.label().c_str(), r.msPerTick,
+                    r.msPerSimSecond, shortNumber(r.summary.tipRms()).c_str(), shortNumber(r.summary.tipMax).c_str(),
+                    shortNumber(r.summary.bodyPosMax).c_str(), diverges, shortNumber(r.modelError.tipRms).c_str(),
+                    r.status().c_str(), r.pareto ? "  * pareto" : "");
       }
     }
     std::printf("\nwrote      %s, %s and %zu plots in %s\n", escapeControl(csvPath).c_str(),
                 escapeControl(jsonPath).c_str(), pngs.size(), escapeControl(o.out).c_str());
     std::printf(
         "* pareto: no other variant of the scenario is both cheaper (ms per simulated second) and more "
-        "accurate (tip RMS error).\n");
+        "accurate (tip RMS error).\n"
+        "model err: one tuft's tip RMS against the reference blade (8 segments, double): 30 s of the scenario's wind "
+        "and a press (docs/grass-models.md).\n");
   }
   if (faults > 0) {
     printError("simgrass sweep: %d variant%s faulted (status column in %s)\n", faults, faults == 1 ? "" : "s",

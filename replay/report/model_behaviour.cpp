@@ -3,14 +3,20 @@
 #include <algorithm>
 #include <cmath>
 
+#include "replay/report/reference_blade.h"
+#include "sim/scenario/derived.h"
+#include "sim/wind/wind.h"
 #include "sim/world/world.h"
 
 namespace sg {
 namespace {
 
-constexpr double kWithin = 0.05;     // m: "back within 5 cm"
-constexpr double kHorizon = 200;     // s looked at after the gust or the press
-constexpr int64_t kLateStart = 600;  // s: "ten minutes in"
+constexpr double kWithin = 0.05;           // m: "back within 5 cm"
+constexpr double kHorizon = 200;           // s looked at after the gust or the press
+constexpr int64_t kLateStart = 600;        // s: "ten minutes in"
+constexpr double kErrorWindSeconds = 30;   // s of the scenario's wind in the model-error run
+constexpr double kErrorPressSeconds = 10;  // s after the press in the model-error run
+constexpr double kPressAngle = 70 * 3.14159265358979323846 / 180;
 
 /// The scenario reduced to one tuft at the origin on flat ground, no bodies, no script.
 Scenario oneTuft(const Scenario& s) {
@@ -97,7 +103,7 @@ ModelBehaviour measureModelBehaviour(const Scenario& scenario) {
   validateForScalar(calm, ScalarKind::Double, 0);
   World<double> w(calm, 1);
   auto& p = w.mutableParticles();
-  const double L = w.particleConstants().rodLength, angle = 70 * 3.14159265358979323846 / 180;
+  const double L = w.particleConstants().rodLength, angle = kPressAngle;
   p.px[0] = p.anchorX[0] + L * std::sin(angle);
   p.py[0] = p.anchorY[0] + L * std::cos(angle);
   p.vx[0] = p.vy[0] = p.vz[0] = 0;
@@ -113,6 +119,85 @@ ModelBehaviour measureModelBehaviour(const Scenario& scenario) {
   b.settleAfterPress = lastOut < end - std::llround(10 / dt) ? double(lastOut + 1) * dt : -1;
   b.downAfterPress = double(lastDown + 1) * dt;
   return b;
+}
+
+namespace {
+
+/// The truth for `s`'s tuft: its length and mass, its blade frequency and damping ratio.
+ReferenceBlade referenceFor(const Scenario& s) {
+  ReferenceBladeParams p;
+  p.length = s.particles.constraintLength.toDouble();
+  p.mass = s.particles.mass.toDouble();
+  p.frequency = s.particles.blade.frequency.toDouble();
+  p.dampingRatio = s.particles.blade.dampingRatio.toDouble();
+  return ReferenceBlade(p);
+}
+
+/// |model tip offset - reference tip| of this tick, added to the sums.
+void compareTips(const World<double>& w, const ReferenceBlade& ref, double* sumSq, double* worst) {
+  const auto& p = w.particles();
+  const auto t = ref.tip();
+  const double e = std::sqrt(std::pow(p.px[0] - p.anchorX[0] - t[0], 2) + std::pow(p.py[0] - p.anchorY[0] - t[1], 2) +
+                             std::pow(p.pz[0] - p.anchorZ[0] - t[2], 2));
+  *sumSq += e * e;
+  *worst = std::max(*worst, e);
+}
+
+}  // namespace
+
+ModelError measureModelError(const Scenario& scenario, const Rational& dt) {
+  Scenario tuft = oneTuft(scenario);
+  tuft.timeStep = dt;
+  validateForScalar(tuft, ScalarKind::Double, 0);
+  const double h = dt.toDouble();
+  ModelError out;
+  double sumSq = 0;
+  int64_t compared = 0;
+
+  // The scenario's wind at the tuft, tick by tick, exactly as the world's schedule has it.
+  const ScenarioConstants constants = deriveConstants(tuft);
+  const WindSchedule schedule = WindSchedule::build(tuft, constants);
+  {
+    World<double> w(tuft, 1);
+    ReferenceBlade ref = referenceFor(tuft);
+    const int64_t ticks = std::llround(kErrorWindSeconds / h);
+    for (int64_t t = 0; t < ticks; ++t) {
+      std::array<double, 3> force{0, 0, 0};
+      for (size_t g = 0; g < schedule.gusts.size(); ++g) {
+        const bool on = schedule.gusts[g].swept ? schedule.activeAt(g, 0, 0, t) : schedule.active(g, 0, t);
+        if (!on) continue;
+        for (int c = 0; c < 3; ++c) force[size_t(c)] += tuft.wind.schedule[g].force[size_t(c)].toDouble();
+      }
+      if (!w.step(TickInput{}).ok) return {INFINITY, INFINITY, double(compared) * h};
+      ref.advance(h, force);
+      compareTips(w, ref, &sumSq, &out.tipMax);
+      ++compared;
+    }
+  }
+  // The press: the tip (and the reference blade, straight) at 70 degrees, at rest, let go.
+  {
+    Scenario calm = tuft;
+    calm.wind.schedule.clear();
+    World<double> w(calm, 1);
+    auto& p = w.mutableParticles();
+    const double L = w.particleConstants().rodLength;
+    p.px[0] = p.anchorX[0] + L * std::sin(kPressAngle);
+    p.py[0] = p.anchorY[0] + L * std::cos(kPressAngle);
+    p.pz[0] = p.anchorZ[0];
+    p.vx[0] = p.vy[0] = p.vz[0] = 0;
+    ReferenceBlade ref = referenceFor(calm);
+    ref.bendTo(kPressAngle);
+    const int64_t ticks = std::llround(kErrorPressSeconds / h);
+    for (int64_t t = 0; t < ticks; ++t) {
+      if (!w.step(TickInput{}).ok) return {INFINITY, INFINITY, double(compared) * h};
+      ref.advance(h, {0, 0, 0});
+      compareTips(w, ref, &sumSq, &out.tipMax);
+      ++compared;
+    }
+  }
+  out.tipRms = compared > 0 ? std::sqrt(sumSq / double(compared)) : 0;
+  out.seconds = double(compared) * h;
+  return out;
 }
 
 }  // namespace sg

@@ -1,0 +1,159 @@
+#include "replay/report/reference_blade.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace sg {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// The chain linearised about upright, in the segments' small angles theta_1..theta_N from the
+/// vertical (node i is ell * sum_(j <= i) theta_j to the side): mass matrix M, bending stiffness
+/// per unit kappa (D^T D, D the first difference with theta_0 = 0) and gravity's (negative)
+/// stiffness G (a node's weight lowers the potential as its segments lean).
+struct Linearised {
+  Eigen::MatrixXd mass, bending, gravity;
+};
+
+Linearised linearise(int n, double segment, double nodeMass, double g) {
+  Linearised l{Eigen::MatrixXd::Zero(n, n), Eigen::MatrixXd::Zero(n, n), Eigen::MatrixXd::Zero(n, n)};
+  for (int j = 0; j < n; ++j) {
+    for (int k = 0; k < n; ++k) l.mass(j, k) = segment * segment * nodeMass * double(n - std::max(j, k));
+    l.bending(j, j) = j + 1 < n ? 2 : 1;  // D^T D of the differences theta_j - theta_(j-1)
+    if (j + 1 < n) l.bending(j, j + 1) = l.bending(j + 1, j) = -1;
+    l.gravity(j, j) = -g * segment * nodeMass * double(n - j);
+  }
+  return l;
+}
+
+/// omega^2 of every mode at bending stiffness kappa, ascending, with the mode shapes (M-normalised).
+Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> modes(const Linearised& l, double kappa) {
+  return Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd>(kappa * l.bending + l.gravity, l.mass);
+}
+
+}  // namespace
+
+ReferenceBlade::ReferenceBlade(const ReferenceBladeParams& p) {
+  if (!(p.length > 0) || !(p.mass > 0) || !(p.frequency > 0) || !(p.dampingRatio >= 0) || !(p.gravity >= 0) ||
+      p.segments < 2 || p.segments > 64)
+    throw std::invalid_argument(
+        "reference blade: expected a positive length, mass and frequency, a damping ratio >= 0 "
+        "and 2 to 64 segments");
+  n_ = p.segments;
+  length_ = p.length;
+  segment_ = p.length / n_;
+  nodeMass_ = p.mass / n_;
+  gravity_ = p.gravity;
+  const Linearised lin = linearise(n_, segment_, nodeMass_, gravity_);
+  // kappa: the first mode's omega^2 grows with kappa (from negative, buckled, at kappa = 0):
+  // bracket it, then bisect to the last bit.
+  const double omega1 = 2 * kPi * p.frequency, target = omega1 * omega1;
+  double lo = 0, hi = nodeMass_ * gravity_ * p.length + target * p.mass * p.length * p.length;
+  for (int i = 0; i < 200 && modes(lin, hi).eigenvalues()(0) < target; ++i) hi *= 2;
+  for (int i = 0; i < 200 && hi - lo > 1e-15 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (modes(lin, mid).eigenvalues()(0) < target ? lo : hi) = mid;
+  }
+  kappa_ = hi;
+  const auto m = modes(lin, kappa_);
+  if (!(m.eigenvalues()(0) > 0)) throw std::invalid_argument("reference blade: no stiffness gives that frequency");
+  omegaMax_ = std::sqrt(m.eigenvalues()(n_ - 1));
+  // Damping proportional to mass (air drag on every node, C = alpha M): every mode keeps its
+  // shape and mode k's ratio is alpha / (2 omega_k), exactly zeta for the first. Integrated as the
+  // exact decay exp(-alpha h) of each substep: stable at any alpha. (Damping the bends' rates,
+  // C proportional to K, damps high modes more but bounds an explicit step by 2 / (beta omega^2):
+  // 64 segments needed ~10^7 substeps a second.)
+  alpha_ = 2 * p.dampingRatio * omega1;
+  // Substep: accurate for the highest mode (h omega_max <= 0.05).
+  h_ = 0.05 / omegaMax_;
+  for (auto* v : {&x_, &y_, &z_, &vx_, &vy_, &vz_, &fx_, &fy_, &fz_, &px_, &py_, &pz_}) v->assign(size_t(n_), 0.0);
+  bendTo(0);
+}
+
+void ReferenceBlade::bendTo(double angle) {
+  for (int i = 0; i < n_; ++i) {
+    const double r = segment_ * (i + 1);
+    x_[size_t(i)] = r * std::sin(angle);
+    y_[size_t(i)] = r * std::cos(angle);
+    z_[size_t(i)] = 0;
+    vx_[size_t(i)] = vy_[size_t(i)] = vz_[size_t(i)] = 0;
+  }
+}
+
+void ReferenceBlade::advance(double seconds, const std::array<double, 3>& windForce) {
+  const int steps = std::max(1, int(std::ceil(seconds / h_ - 1e-9)));
+  const double h = seconds / steps;
+  for (int s = 0; s < steps; ++s) substepOnce(h, windForce);
+}
+
+void ReferenceBlade::substepOnce(double h, const std::array<double, 3>& windForce) {
+  const size_t n = size_t(n_);
+  // Forces: weight and wind on every node.
+  for (size_t i = 0; i < n; ++i) {
+    fx_[i] = windForce[0] / n_;
+    fy_[i] = windForce[1] / n_ - nodeMass_ * gravity_;
+    fz_[i] = windForce[2] / n_;
+  }
+  // Bending. Segment j runs from node j-1 (the root for j = 0) to node j; its
+  // tangent t_j and the tangent's rate; e_j = t_j - t_(j-1) with t_(-1) = up and rate 0.
+  struct Seg {
+    double t[3], len;
+  };
+  std::vector<Seg> seg(n);
+  for (size_t j = 0; j < n; ++j) {
+    const double ax = j ? x_[j - 1] : 0, ay = j ? y_[j - 1] : 0, az = j ? z_[j - 1] : 0;
+    const double d[3] = {x_[j] - ax, y_[j] - ay, z_[j] - az};
+    Seg& s = seg[j];
+    s.len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (int c = 0; c < 3; ++c) s.t[c] = d[c] / s.len;
+  }
+  // Component c of e_j (j = n: none, the free tip).
+  auto bend = [&](size_t j, int c) {
+    return j >= n ? 0.0 : seg[j].t[c] - (j ? seg[j - 1].t[c] : (c == 1 ? 1.0 : 0.0));
+  };
+  for (size_t j = 0; j < n; ++j) {
+    // dE/dt_j = kappa (e_j - e_(j+1)), through dt_j/dx_j = (I - t t^T)/len: a force on node j
+    // and the opposite on node j-1.
+    double g[3];
+    for (int c = 0; c < 3; ++c) g[c] = kappa_ * (bend(j, c) - bend(j + 1, c));
+    const Seg& s = seg[j];
+    const double along = s.t[0] * g[0] + s.t[1] * g[1] + s.t[2] * g[2];
+    double f[3];
+    for (int c = 0; c < 3; ++c) f[c] = (g[c] - s.t[c] * along) / s.len;
+    fx_[j] -= f[0], fy_[j] -= f[1], fz_[j] -= f[2];
+    if (j > 0) fx_[j - 1] += f[0], fy_[j - 1] += f[1], fz_[j - 1] += f[2];
+  }
+  // Symplectic Euler with the drag's exact decay, then the lengths and the ground, then the
+  // velocities from the positions.
+  const double decay = std::exp(-alpha_ * h);
+  for (size_t i = 0; i < n; ++i) {
+    px_[i] = x_[i], py_[i] = y_[i], pz_[i] = z_[i];
+    vx_[i] = (vx_[i] + h * fx_[i] / nodeMass_) * decay;
+    vy_[i] = (vy_[i] + h * fy_[i] / nodeMass_) * decay;
+    vz_[i] = (vz_[i] + h * fz_[i] / nodeMass_) * decay;
+    x_[i] += h * vx_[i];
+    y_[i] += h * vy_[i];
+    z_[i] += h * vz_[i];
+  }
+  for (int sweep = 0; sweep < 4; ++sweep)
+    for (size_t j = 0; j < n; ++j) {
+      const double ax = j ? x_[j - 1] : 0, ay = j ? y_[j - 1] : 0, az = j ? z_[j - 1] : 0;
+      const double dx = x_[j] - ax, dy = y_[j] - ay, dz = z_[j] - az;
+      const double len = std::sqrt(dx * dx + dy * dy + dz * dz);
+      const double stretch = (len - segment_) / len;
+      const double share = j ? 0.5 : 1.0;  // equal node masses; the root does not move
+      x_[j] -= share * stretch * dx, y_[j] -= share * stretch * dy, z_[j] -= share * stretch * dz;
+      if (j) x_[j - 1] += share * stretch * dx, y_[j - 1] += share * stretch * dy, z_[j - 1] += share * stretch * dz;
+    }
+  for (size_t i = 0; i < n; ++i) {
+    y_[i] = std::max(y_[i], 0.0);
+    vx_[i] = (x_[i] - px_[i]) / h;
+    vy_[i] = (y_[i] - py_[i]) / h;
+    vz_[i] = (z_[i] - pz_[i]) / h;
+  }
+}
+
+}  // namespace sg

@@ -1,0 +1,65 @@
+// The truth that grass models are measured against (issue 16, docs/grass-models.md "Model
+// error"): one blade as a chain of N straight segments, in double, at a time step small enough
+// that its own discretisation error is negligible beside any model's. Not part of the step (it
+// uses libm and runs only in tools: the sweep's model error, tests).
+//
+// The blade: length L, mass m spread evenly over its N nodes (the root is clamped upright),
+// gravity g = 9.81 m/s^2 down, bending energy (kappa/2) sum_j |t_j - t_(j-1)|^2 over the unit
+// tangents of consecutive segments (t_0 = up: the clamp), and a drag alpha m_i v_i on every node.
+// kappa is chosen so that the first bending mode, gravity included, sways at the scenario's blade
+// frequency f; alpha = 2 zeta omega_1 so that this mode's damping ratio is the scenario's zeta
+// (mode k's is zeta omega_1 / omega_k). Wind is a force per tuft (N), spread evenly over the
+// nodes: drag on a uniform blade.
+//
+// Step (substep h): v = (v + h (gravity + wind/N + bending)/m_i) exp(-alpha h); x += h v; the
+// segment lengths are restored by mass-weighted projection, root to tip, 4 sweeps; nodes are
+// kept above the root's height; v = (x - x_before)/h. h is chosen from the chain's highest
+// linearised mode, h omega_max <= 0.05.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+namespace sg {
+
+struct ReferenceBladeParams {
+  double length = 1;          ///< m
+  double mass = 1;            ///< kg, the whole blade
+  double frequency = 0.5;     ///< Hz: first bending mode, gravity included
+  double dampingRatio = 0.3;  ///< of critical, first mode
+  double gravity = 9.81;      ///< m/s^2, down
+  int segments = 8;
+};
+
+class ReferenceBlade {
+ public:
+  /// Upright and at rest, root at the origin. Throws std::invalid_argument for parameters no
+  /// blade has (a non-positive length, mass or frequency, a negative damping ratio, fewer than 2
+  /// segments) or a frequency so low that the blade buckles under its own weight.
+  explicit ReferenceBlade(const ReferenceBladeParams& p);
+
+  /// Advances `seconds` (in whole substeps of at most substep()) under a total wind force
+  /// (N, spread evenly over the nodes).
+  void advance(double seconds, const std::array<double, 3>& windForce);
+
+  /// Puts the blade straight at `angle` (rad) from upright toward +x, at rest.
+  void bendTo(double angle);
+
+  std::array<double, 3> tip() const { return {x_.back(), y_.back(), z_.back()}; }
+  double substep() const { return h_; }
+  double bendingStiffness() const { return kappa_; }  ///< kappa, N m (per unit bend)
+  double dragRate() const { return alpha_; }          ///< alpha, 1/s
+  double highestMode() const { return omegaMax_; }    ///< rad/s, linearised
+
+ private:
+  void substepOnce(double h, const std::array<double, 3>& windForce);
+
+  int n_ = 0;
+  double length_ = 0, segment_ = 0, nodeMass_ = 0, gravity_ = 0;
+  double kappa_ = 0, alpha_ = 0, omegaMax_ = 0, h_ = 0;
+  std::vector<double> x_, y_, z_, vx_, vy_, vz_;     ///< nodes 1..N (index 0 = node 1)
+  std::vector<double> fx_, fy_, fz_, px_, py_, pz_;  ///< scratch: forces, positions before
+};
+
+}  // namespace sg
