@@ -105,6 +105,25 @@ TEST(ReferenceBlade, ConvergesInTheNumberOfSegments) {
   EXPECT_LT(e8, 0.02);  // 2 cm on a 1 m blade swinging ~30 cm
 }
 
+TEST(ReferenceBlade, KeepsItsLengthUnderAnyForce) {
+  // A reviewer's 1e-9 kg blade in a 1e4 N wind stretched to 5.7e5 m (the mass-weighted sweeps
+  // alone cannot hold it); an upward 1e6 N wind stretched a 1 kg blade by 11 %. The tip stays
+  // within L (1 + 1e-3) of the root (the length tolerance before the exact pass), and above it.
+  for (const auto& [mass, force] :
+       {std::pair{1e-9, std::array<double, 3>{1e4, 0, 0}}, std::pair{1.0, std::array<double, 3>{0, 1e6, 0}},
+        std::pair{1e-7, std::array<double, 3>{-3, -5, 2}}}) {
+    ReferenceBladeParams p;
+    p.length = 0.5, p.mass = mass;
+    ReferenceBlade b(p);
+    for (int i = 0; i < 120; ++i) {
+      b.advance(1.0 / 60, force);
+      const auto t = b.tip();
+      ASSERT_LE(std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]), p.length * (1 + 1e-3)) << mass << " tick " << i;
+      ASSERT_GE(t[1], 0.0) << mass << " tick " << i;
+    }
+  }
+}
+
 TEST(ReferenceBlade, RefusesParametersNoBladeHas) {
   for (auto bad : {ReferenceBladeParams{0, 1, 0.5, 0.3, 9.81, 8}, ReferenceBladeParams{1, -1, 0.5, 0.3, 9.81, 8},
                    ReferenceBladeParams{1, 1, 0, 0.3, 9.81, 8}, ReferenceBladeParams{1, 1, 0.5, -0.1, 9.81, 8},

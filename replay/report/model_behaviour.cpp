@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "replay/report/reference_blade.h"
 #include "sim/scenario/derived.h"
@@ -133,66 +134,92 @@ ReferenceBlade referenceFor(const Scenario& s) {
   return ReferenceBlade(p);
 }
 
-/// |model tip offset - reference tip| of this tick, added to the sums.
-void compareTips(const World<double>& w, const ReferenceBlade& ref, double* sumSq, double* worst) {
-  const auto& p = w.particles();
-  const auto t = ref.tip();
-  const double e = std::sqrt(std::pow(p.px[0] - p.anchorX[0] - t[0], 2) + std::pow(p.py[0] - p.anchorY[0] - t[1], 2) +
-                             std::pow(p.pz[0] - p.anchorZ[0] - t[2], 2));
-  *sumSq += e * e;
-  *worst = std::max(*worst, e);
+/// The scenario's one tuft at time step dt, validated (throws ScenarioError).
+Scenario errorTuft(const Scenario& scenario, const Rational& dt) {
+  Scenario tuft = oneTuft(scenario);
+  tuft.timeStep = dt;
+  validateForScalar(tuft, ScalarKind::Double, 0);
+  return tuft;
+}
+
+int64_t windTicks(double dt) { return std::llround(kErrorWindSeconds / dt); }
+int64_t pressTicks(double dt) { return std::llround(kErrorPressSeconds / dt); }
+
+/// The tuft pressed to kPressAngle, at rest.
+void press(World<double>& w) {
+  auto& p = w.mutableParticles();
+  const double L = w.particleConstants().rodLength;
+  p.px[0] = p.anchorX[0] + L * std::sin(kPressAngle);
+  p.py[0] = p.anchorY[0] + L * std::cos(kPressAngle);
+  p.pz[0] = p.anchorZ[0];
+  p.vx[0] = p.vy[0] = p.vz[0] = 0;
 }
 
 }  // namespace
 
-ModelError measureModelError(const Scenario& scenario, const Rational& dt) {
-  Scenario tuft = oneTuft(scenario);
-  tuft.timeStep = dt;
-  validateForScalar(tuft, ScalarKind::Double, 0);
+std::vector<std::array<double, 3>> referenceTips(const Scenario& scenario, const Rational& dt) {
+  const Scenario tuft = errorTuft(scenario, dt);
   const double h = dt.toDouble();
+  std::vector<std::array<double, 3>> tips;
+  // The scenario's wind at the tuft, tick by tick, exactly as the world's schedule has it.
+  const WindSchedule schedule = WindSchedule::build(tuft, deriveConstants(tuft));
+  ReferenceBlade ref = referenceFor(tuft);
+  for (int64_t t = 0, ticks = windTicks(h); t < ticks; ++t) {
+    std::array<double, 3> force{0, 0, 0};
+    for (size_t g = 0; g < schedule.gusts.size(); ++g) {
+      const bool on = schedule.gusts[g].swept ? schedule.activeAt(g, 0, 0, t) : schedule.active(g, 0, t);
+      if (!on) continue;
+      for (size_t c = 0; c < 3; ++c) force[c] += tuft.wind.schedule[g].force[c].toDouble();
+    }
+    ref.advance(h, force);
+    tips.push_back(ref.tip());
+  }
+  // The press: the blade straight at 70 degrees, at rest, let go in still air.
+  ref.bendTo(kPressAngle);
+  for (int64_t t = 0, ticks = pressTicks(h); t < ticks; ++t) {
+    ref.advance(h, {0, 0, 0});
+    tips.push_back(ref.tip());
+  }
+  return tips;
+}
+
+ModelError measureModelError(const Scenario& scenario, const Rational& dt,
+                             const std::vector<std::array<double, 3>>* reference) {
+  const Scenario tuft = errorTuft(scenario, dt);
+  const double h = dt.toDouble();
+  std::vector<std::array<double, 3>> own;
+  if (!reference) reference = &(own = referenceTips(scenario, dt));
+  const int64_t wind = windTicks(h), total = wind + pressTicks(h);
+  if (int64_t(reference->size()) != total)
+    throw std::invalid_argument("measureModelError: the reference tips are not of this scenario and dt");
   ModelError out;
   double sumSq = 0;
   int64_t compared = 0;
-
-  // The scenario's wind at the tuft, tick by tick, exactly as the world's schedule has it.
-  const ScenarioConstants constants = deriveConstants(tuft);
-  const WindSchedule schedule = WindSchedule::build(tuft, constants);
+  auto compare = [&](const World<double>& w) {
+    const auto& p = w.particles();
+    const auto& t = (*reference)[size_t(compared)];
+    const double ex = p.px[0] - p.anchorX[0] - t[0], ey = p.py[0] - p.anchorY[0] - t[1],
+                 ez = p.pz[0] - p.anchorZ[0] - t[2];
+    const double e = std::sqrt(ex * ex + ey * ey + ez * ez);
+    sumSq += e * e;
+    out.tipMax = std::max(out.tipMax, e);
+    ++compared;
+  };
   {
     World<double> w(tuft, 1);
-    ReferenceBlade ref = referenceFor(tuft);
-    const int64_t ticks = std::llround(kErrorWindSeconds / h);
-    for (int64_t t = 0; t < ticks; ++t) {
-      std::array<double, 3> force{0, 0, 0};
-      for (size_t g = 0; g < schedule.gusts.size(); ++g) {
-        const bool on = schedule.gusts[g].swept ? schedule.activeAt(g, 0, 0, t) : schedule.active(g, 0, t);
-        if (!on) continue;
-        for (int c = 0; c < 3; ++c) force[size_t(c)] += tuft.wind.schedule[g].force[size_t(c)].toDouble();
-      }
+    for (int64_t t = 0; t < wind; ++t) {
       if (!w.step(TickInput{}).ok) return {INFINITY, INFINITY, double(compared) * h};
-      ref.advance(h, force);
-      compareTips(w, ref, &sumSq, &out.tipMax);
-      ++compared;
+      compare(w);
     }
   }
-  // The press: the tip (and the reference blade, straight) at 70 degrees, at rest, let go.
   {
     Scenario calm = tuft;
     calm.wind.schedule.clear();
     World<double> w(calm, 1);
-    auto& p = w.mutableParticles();
-    const double L = w.particleConstants().rodLength;
-    p.px[0] = p.anchorX[0] + L * std::sin(kPressAngle);
-    p.py[0] = p.anchorY[0] + L * std::cos(kPressAngle);
-    p.pz[0] = p.anchorZ[0];
-    p.vx[0] = p.vy[0] = p.vz[0] = 0;
-    ReferenceBlade ref = referenceFor(calm);
-    ref.bendTo(kPressAngle);
-    const int64_t ticks = std::llround(kErrorPressSeconds / h);
-    for (int64_t t = 0; t < ticks; ++t) {
+    press(w);
+    while (compared < total) {
       if (!w.step(TickInput{}).ok) return {INFINITY, INFINITY, double(compared) * h};
-      ref.advance(h, {0, 0, 0});
-      compareTips(w, ref, &sumSq, &out.tipMax);
-      ++compared;
+      compare(w);
     }
   }
   out.tipRms = compared > 0 ? std::sqrt(sumSq / double(compared)) : 0;

@@ -4,6 +4,9 @@
 // pressed tuft stays down. docs/grass-models.md.
 #pragma once
 
+#include <array>
+#include <vector>
+
 #include "sim/scenario/scenario.h"
 
 namespace sg {
@@ -32,8 +35,15 @@ struct ModelError {
   double seconds = 0;  ///< simulated s compared (both runs)
 };
 
-/// `scenario`'s grass model at time step `dt`, in double. Throws ScenarioError when the
-/// scenario does not validate at that step.
-ModelError measureModelError(const Scenario& scenario, const Rational& dt);
+/// The reference blade's tip offset at every tick of those two runs, for `scenario` at `dt`. The
+/// same for every grass model (it reads the tuft's length, mass, blade frequency and damping
+/// ratio and the wind only): the sweep computes it once per scenario file and dt.
+std::vector<std::array<double, 3>> referenceTips(const Scenario& scenario, const Rational& dt);
+
+/// `scenario`'s grass model at time step `dt`, in double, against `reference` (referenceTips of
+/// the same scenario and dt; null: computed here). Throws ScenarioError when the scenario does
+/// not validate at that step.
+ModelError measureModelError(const Scenario& scenario, const Rational& dt,
+                             const std::vector<std::array<double, 3>>* reference = nullptr);
 
 }  // namespace sg

@@ -12,9 +12,11 @@
 // nodes: drag on a uniform blade.
 //
 // Step (substep h): v = (v + h (gravity + wind/N + bending)/m_i) exp(-alpha h); x += h v; the
-// segment lengths are restored by mass-weighted projection, root to tip, 4 sweeps; nodes are
-// kept above the root's height; v = (x - x_before)/h. h is chosen from the chain's highest
-// linearised mode, h omega_max <= 0.05.
+// segment lengths are restored by mass-weighted projection, root to tip, until within 1e-6 (at
+// most 64 sweeps); nodes are kept above the root's height; where a length still does not hold
+// to 1e-3 (forces per unit mass far beyond a scenario's) each node is put back at its length root to
+// tip, so a tip is never farther than L (1 + 1e-3) from its root; v = (x - x_before)/h. h is chosen from
+// the chain's highest linearised mode, h omega_max <= 0.05.
 #pragma once
 
 #include <array>
