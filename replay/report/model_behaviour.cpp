@@ -19,6 +19,16 @@ constexpr double kErrorWindSeconds = 30;   // s of the scenario's wind in the mo
 constexpr double kErrorPressSeconds = 10;  // s after the press in the model-error run
 constexpr double kPressAngle = 70 * 3.14159265358979323846 / 180;
 
+/// The tuft pressed to kPressAngle, at rest.
+void press(World<double>& w) {
+  auto& p = w.mutableParticles();
+  const double L = w.particleConstants().rodLength;
+  p.px[0] = p.anchorX[0] + L * std::sin(kPressAngle);
+  p.py[0] = p.anchorY[0] + L * std::cos(kPressAngle);
+  p.pz[0] = p.anchorZ[0];
+  p.vx[0] = p.vy[0] = p.vz[0] = 0;
+}
+
 /// The scenario reduced to one tuft at the origin on flat ground, no bodies, no script.
 Scenario oneTuft(const Scenario& s) {
   Scenario t = s;
@@ -103,11 +113,9 @@ ModelBehaviour measureModelBehaviour(const Scenario& scenario) {
   calm.wind.schedule.clear();
   validateForScalar(calm, ScalarKind::Double, 0);
   World<double> w(calm, 1);
+  press(w);
   auto& p = w.mutableParticles();
-  const double L = w.particleConstants().rodLength, angle = kPressAngle;
-  p.px[0] = p.anchorX[0] + L * std::sin(angle);
-  p.py[0] = p.anchorY[0] + L * std::cos(angle);
-  p.vx[0] = p.vy[0] = p.vz[0] = 0;
+  const double L = w.particleConstants().rodLength;
   if (!p.trample.empty()) p.trample[0] = 1;
   const double dt = calm.timeStep.toDouble();
   const int64_t end = std::llround(kHorizon / dt);
@@ -144,16 +152,6 @@ Scenario errorTuft(const Scenario& scenario, const Rational& dt) {
 
 int64_t windTicks(double dt) { return std::llround(kErrorWindSeconds / dt); }
 int64_t pressTicks(double dt) { return std::llround(kErrorPressSeconds / dt); }
-
-/// The tuft pressed to kPressAngle, at rest.
-void press(World<double>& w) {
-  auto& p = w.mutableParticles();
-  const double L = w.particleConstants().rodLength;
-  p.px[0] = p.anchorX[0] + L * std::sin(kPressAngle);
-  p.py[0] = p.anchorY[0] + L * std::cos(kPressAngle);
-  p.pz[0] = p.anchorZ[0];
-  p.vx[0] = p.vy[0] = p.vz[0] = 0;
-}
 
 }  // namespace
 

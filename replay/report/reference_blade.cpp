@@ -70,6 +70,7 @@ ReferenceBlade::ReferenceBlade(const ReferenceBladeParams& p) {
   // Substep: accurate for the highest mode (h omega_max <= 0.05).
   h_ = 0.05 / omegaMax_;
   for (auto* v : {&x_, &y_, &z_, &vx_, &vy_, &vz_, &fx_, &fy_, &fz_, &px_, &py_, &pz_}) v->assign(size_t(n_), 0.0);
+  tangent_.assign(size_t(n_), {0, 0, 0, 0});
   bendTo(0);
 }
 
@@ -97,32 +98,26 @@ void ReferenceBlade::substepOnce(double h, const std::array<double, 3>& windForc
     fy_[i] = windForce[1] / n_ - nodeMass_ * gravity_;
     fz_[i] = windForce[2] / n_;
   }
-  // Bending. Segment j runs from node j-1 (the root for j = 0) to node j; its
-  // tangent t_j and the tangent's rate; e_j = t_j - t_(j-1) with t_(-1) = up and rate 0.
-  struct Seg {
-    double t[3], len;
-  };
-  std::vector<Seg> seg(n);
+  // Bending. Segment j runs from node j-1 (the root for j = 0) to node j: its unit tangent t_j
+  // (components 0-2) and length (3); e_j = t_j - t_(j-1), with t_(-1) = up (the clamp).
+  std::vector<std::array<double, 4>>& seg = tangent_;
   for (size_t j = 0; j < n; ++j) {
     const double ax = j ? x_[j - 1] : 0, ay = j ? y_[j - 1] : 0, az = j ? z_[j - 1] : 0;
     const double d[3] = {x_[j] - ax, y_[j] - ay, z_[j] - az};
-    Seg& s = seg[j];
-    s.len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    for (int c = 0; c < 3; ++c) s.t[c] = d[c] / s.len;
+    const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    seg[j] = {d[0] / len, d[1] / len, d[2] / len, len};
   }
   // Component c of e_j (j = n: none, the free tip).
-  auto bend = [&](size_t j, int c) {
-    return j >= n ? 0.0 : seg[j].t[c] - (j ? seg[j - 1].t[c] : (c == 1 ? 1.0 : 0.0));
-  };
+  auto bend = [&](size_t j, size_t c) { return j >= n ? 0.0 : seg[j][c] - (j ? seg[j - 1][c] : (c == 1 ? 1.0 : 0.0)); };
   for (size_t j = 0; j < n; ++j) {
     // dE/dt_j = kappa (e_j - e_(j+1)), through dt_j/dx_j = (I - t t^T)/len: a force on node j
     // and the opposite on node j-1.
     double g[3];
-    for (int c = 0; c < 3; ++c) g[c] = kappa_ * (bend(j, c) - bend(j + 1, c));
-    const Seg& s = seg[j];
-    const double along = s.t[0] * g[0] + s.t[1] * g[1] + s.t[2] * g[2];
+    for (size_t c = 0; c < 3; ++c) g[c] = kappa_ * (bend(j, c) - bend(j + 1, c));
+    const std::array<double, 4>& t = seg[j];
+    const double along = t[0] * g[0] + t[1] * g[1] + t[2] * g[2];
     double f[3];
-    for (int c = 0; c < 3; ++c) f[c] = (g[c] - s.t[c] * along) / s.len;
+    for (size_t c = 0; c < 3; ++c) f[c] = (g[c] - t[c] * along) / t[3];
     fx_[j] -= f[0], fy_[j] -= f[1], fz_[j] -= f[2];
     if (j > 0) fx_[j - 1] += f[0], fy_[j - 1] += f[1], fz_[j - 1] += f[2];
   }

@@ -62,6 +62,7 @@ class ReferenceBlade {
   double kappa_ = 0, alpha_ = 0, omegaMax_ = 0, h_ = 0;
   std::vector<double> x_, y_, z_, vx_, vy_, vz_;     ///< nodes 1..N (index 0 = node 1)
   std::vector<double> fx_, fy_, fz_, px_, py_, pz_;  ///< scratch: forces, positions before
+  std::vector<std::array<double, 4>> tangent_;       ///< scratch: each segment's unit tangent and length
 };
 
 }  // namespace sg
