@@ -7,6 +7,8 @@
 // overflow. The patch stage (sim/patches/patch_row_avx2.cpp): the row blend (1/4, 1/2, 3/4), the
 // k = 2 and 4 interpolation along x and the patch writes on edge and random values. Then whole worlds: every tick's
 // hash and every patch's derived state equal between the two kernels on the golden scenarios.
+// The blade model's row (sim/particles/blade_row_avx2.cpp vs blade.h) likewise, with and
+// without trample levels, and in whole worlds under that model.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -20,6 +22,7 @@
 #include <vector>
 
 #include "replay/scenario_files.h"
+#include "sim/particles/blade.h"
 #include "sim/particles/particle_row.h"
 #include "sim/world/world.h"
 #include "tests/test_support.h"
@@ -350,31 +353,39 @@ Raw<S> interestingRaw(std::mt19937_64& rng) {
   return rng() % 2 ? Raw<S>(U(0) - U(r)) : r;  // wraps at the extreme: also interesting
 }
 
+/// A row of eight resting particles in which particle `rep % 8` has interesting values (around the
+/// kernels' bounds) in the fields `mask` picks, so that its own lanes decide. `mask` bit 9 is
+/// for the caller (the blade test's trample level).
+template <class S>
+RowCase<S> rowAroundBounds(std::mt19937_64& rng, const ParticleConstants<S>& c, int rep, unsigned mask) {
+  std::vector<std::array<Raw<S>, 3>> plain(8, {1000, c.rodLength.raw(), -999});
+  RowCase<S> row = restingRow<S>(plain, c);
+  auto pick = [&](bool interesting, Raw<S> ordinary) { return interesting ? interestingRaw<S>(rng) : ordinary; };
+  const size_t i = size_t(rep) % 8;
+  row.p.anchorX[i] = S::fromRaw(pick(mask & 1, row.p.anchorX[i].raw()));
+  row.p.anchorY[i] = S::fromRaw(pick(mask & 2, row.p.anchorY[i].raw()));
+  // Positions: anchor plus an interesting offset (wrapping), or interesting outright.
+  auto offset = [&](S anchor, unsigned bit, Raw<S> ordinary) {
+    using U = std::make_unsigned_t<Raw<S>>;
+    return S::fromRaw(Raw<S>(U(anchor.raw()) + U(pick(mask & bit, ordinary))));
+  };
+  row.p.px[i] = offset(row.p.anchorX[i], 4, 1000);
+  row.p.py[i] = offset(row.p.anchorY[i], 8, c.rodLength.raw());
+  row.p.pz[i] = mask & 16 ? S::fromRaw(interestingRaw<S>(rng)) : row.p.pz[i];
+  row.p.vx[i] = S::fromRaw(pick(mask & 32, 0));
+  row.p.vy[i] = S::fromRaw(pick(mask & 64, 0));
+  row.p.vz[i] = S::fromRaw(pick(mask & 128, 0));
+  if (mask & 256) row.dvy = S::fromRaw(interestingRaw<S>(rng));
+  return row;
+}
+
 TYPED_TEST(AvxKernel, StatesAroundEveryBoundMatchTheReference) {
   using S = TypeParam;
   std::mt19937_64 rng(2024);
   const ParticleConstants<S> c = thesisConstants<S>();
   for (int rep = 0; rep < 6000; ++rep) {
-    // One special particle among seven ordinary ones, so that its own lanes decide.
-    std::vector<std::array<Raw<S>, 3>> plain(8, {1000, c.rodLength.raw(), -999});
-    RowCase<S> row = restingRow<S>(plain, c);
-    auto pick = [&](bool interesting, Raw<S> ordinary) { return interesting ? interestingRaw<S>(rng) : ordinary; };
-    const size_t i = size_t(rep) % 8;
     const unsigned mask = unsigned(rng());  // which fields get an interesting value
-    row.p.anchorX[i] = S::fromRaw(pick(mask & 1, row.p.anchorX[i].raw()));
-    row.p.anchorY[i] = S::fromRaw(pick(mask & 2, row.p.anchorY[i].raw()));
-    // Positions: anchor plus an interesting offset (wrapping), or interesting outright.
-    auto offset = [&](S anchor, unsigned bit, Raw<S> ordinary) {
-      using U = std::make_unsigned_t<Raw<S>>;
-      return S::fromRaw(Raw<S>(U(anchor.raw()) + U(pick(mask & bit, ordinary))));
-    };
-    row.p.px[i] = offset(row.p.anchorX[i], 4, 1000);
-    row.p.py[i] = offset(row.p.anchorY[i], 8, c.rodLength.raw());
-    row.p.pz[i] = mask & 16 ? S::fromRaw(interestingRaw<S>(rng)) : row.p.pz[i];
-    row.p.vx[i] = S::fromRaw(pick(mask & 32, 0));
-    row.p.vy[i] = S::fromRaw(pick(mask & 64, 0));
-    row.p.vz[i] = S::fromRaw(pick(mask & 128, 0));
-    if (mask & 256) row.dvy = S::fromRaw(interestingRaw<S>(rng));
+    const RowCase<S> row = rowAroundBounds<S>(rng, c, rep, mask);
     expectSameAsReference<S, false>(row, "thesis, rep " + std::to_string(rep));
     expectSameAsReference<S, true>(row, "pbd, rep " + std::to_string(rep));
     if (::testing::Test::HasFailure()) return;
@@ -411,6 +422,148 @@ TYPED_TEST(AvxKernel, ConstantsOutsideTheKernelsRangeRunTheReference) {
   row = realisticRow<S>(40, rng);
   row.c.dt = S(2);  // dt above 1 s: the wide product
   expectSameAsReference<S, false>(row, "dt = 2 s");
+}
+
+// ---- the blade model's row (sim/particles/blade_row_avx2.cpp) ---------------------------------
+
+/// The blade constants of a 1.5 Hz blade, damping ratio 0.3, trampled for 2 s, at 60 Hz.
+template <class S>
+ParticleConstants<S> bladeConstants(double rod = 0.5) {
+  ParticleConstants<S> c = thesisConstants<S>(rod);
+  const double omega = 2 * 3.141592653589793 * 1.5;
+  c.bladeStiffnessDt = fromDouble<S>((omega * omega + 9.81 / rod) / 60);
+  c.bladeDampingPerTick = fromDouble<S>(0.9885 * std::exp(-2 * 0.3 * omega / 60));
+  c.trampleDecayPerTick = fromDouble<S>(1.0 / 120);
+  c.invRodLength = fromDouble<S>(1 / rod);
+  return c;
+}
+
+/// A realistic row under the blade constants, with trample levels in [0, 1] (0 and 1 included).
+template <class S>
+RowCase<S> bladeRow(size_t n, std::mt19937_64& rng, double speed = 3.0) {
+  RowCase<S> r = realisticRow<S>(n, rng, speed);
+  r.c = bladeConstants<S>();
+  r.p.trample.assign(n, S(0));
+  for (size_t i = 0; i < n; ++i) {
+    const uint64_t pick = rng() % 4;
+    r.p.trample[i] = pick == 0 ? S(0) : pick == 1 ? S(1) : fromDouble<S>(double(rng() % 1000) / 1000);
+  }
+  return r;
+}
+
+template <class S, bool Tramples>
+RowResult<S> runBladeRow(const RowCase<S>& in, ParticleKernel kernel) {
+  RowResult<S> r;
+  r.p = in.p;
+  if (!Tramples) r.p.trample.clear();
+  const size_t n = in.p.px.size();
+  r.dx.assign(n, S(0));
+  r.dy.assign(n, S(0));
+  r.dz.assign(n, S(0));
+  takeFixedFaults();
+  r.fault.particle =
+      advanceBladeRow<S, Tramples>(kernel, r.p, 0, int64_t(n), in.dvx, in.dvy, in.dvz, in.c, r.dx, r.dy, r.dz);
+  r.faultBits = takeFixedFaults();
+  return r;
+}
+
+/// Both kernels on a blade row, with and without trampling: the same report always, the same
+/// state (trample levels included) and displacement when nothing faulted.
+template <class S>
+void expectBladeSameAsReference(const RowCase<S>& in, const std::string& what) {
+  auto compare = [&](const RowResult<S>& ref, const RowResult<S>& vec, const std::string& how) {
+    ASSERT_EQ(vec.fault.particle, ref.fault.particle) << how;
+    ASSERT_EQ(vec.faultBits, ref.faultBits) << how;
+    if (ref.fault.particle >= 0) return;
+    EXPECT_EQ(raws(vec.p.px), raws(ref.p.px)) << how;
+    EXPECT_EQ(raws(vec.p.py), raws(ref.p.py)) << how;
+    EXPECT_EQ(raws(vec.p.pz), raws(ref.p.pz)) << how;
+    EXPECT_EQ(raws(vec.p.vx), raws(ref.p.vx)) << how;
+    EXPECT_EQ(raws(vec.p.vy), raws(ref.p.vy)) << how;
+    EXPECT_EQ(raws(vec.p.vz), raws(ref.p.vz)) << how;
+    EXPECT_EQ(raws(vec.p.trample), raws(ref.p.trample)) << how;
+    EXPECT_EQ(raws(vec.dx), raws(ref.dx)) << how;
+    EXPECT_EQ(raws(vec.dy), raws(ref.dy)) << how;
+    EXPECT_EQ(raws(vec.dz), raws(ref.dz)) << how;
+  };
+  compare(runBladeRow<S, false>(in, ParticleKernel::Scalar), runBladeRow<S, false>(in, ParticleKernel::Avx2),
+          what + " (blade)");
+  compare(runBladeRow<S, true>(in, ParticleKernel::Scalar), runBladeRow<S, true>(in, ParticleKernel::Avx2),
+          what + " (blade, trampling)");
+}
+
+TYPED_TEST(AvxKernel, BladeRowsOfEveryLengthMatchTheReference) {
+  using S = TypeParam;
+  std::mt19937_64 rng(17);
+  for (size_t n = 0; n <= 37; ++n) expectBladeSameAsReference<S>(bladeRow<S>(n, rng), "n = " + std::to_string(n));
+  for (int rep = 0; rep < 20; ++rep)
+    expectBladeSameAsReference<S>(bladeRow<S>(1001, rng, rep % 2 ? 0.2 : 30.0), "long row " + std::to_string(rep));
+}
+
+TYPED_TEST(AvxKernel, BladeStatesAroundEveryBoundMatchTheReference) {
+  using S = TypeParam;
+  std::mt19937_64 rng(2025);
+  const ParticleConstants<S> c = bladeConstants<S>();
+  for (int rep = 0; rep < 6000; ++rep) {
+    const unsigned mask = unsigned(rng());
+    RowCase<S> row = rowAroundBounds<S>(rng, c, rep, mask);
+    row.p.trample.assign(8, fromDouble<S>(0.25));
+    // beyond [0, 1]: a hostile state
+    if (mask & 512) row.p.trample[size_t(rep) % 8] = S::fromRaw(interestingRaw<S>(rng));
+    expectBladeSameAsReference<S>(row, "rep " + std::to_string(rep));
+    if (::testing::Test::HasFailure()) return;
+  }
+}
+
+TYPED_TEST(AvxKernel, BladeTipsAtTheRootAndRandomBitsMatchTheReference) {
+  using S = TypeParam;
+  std::mt19937_64 rng(23);
+  // A tip driven exactly onto its root (the reference stands it upright) and one below it.
+  RowCase<S> row = bladeRow<S>(16, rng, 0.0);
+  for (size_t i = 0; i < 16; ++i) {
+    row.p.vx[i] = row.p.vy[i] = row.p.vz[i] = S(0);
+    row.p.trample[i] = S(1);  // no recovery force: the tip moves by dv only
+  }
+  row.dvx = row.dvy = row.dvz = S(0);
+  row.p.px[5] = row.p.anchorX[5];
+  row.p.py[5] = row.p.anchorY[5];
+  row.p.pz[5] = row.p.anchorZ[5];
+  row.p.py[10] = row.p.anchorY[10] - S(1);
+  expectBladeSameAsReference<S>(row, "tips at and below the root");
+  // A root within L of the format's top, its tip below the root: the reference forms the upright
+  // tip anchor + L before it knows it needs it, and faults there.
+  row.p.anchorY[13] = S::fromRaw(Raw<S>(S::max().raw() - row.c.rodLength.raw() / 2));
+  row.p.py[13] = row.p.anchorY[13] - fromDouble<S>(0.3);
+  expectBladeSameAsReference<S>(row, "a root at the top of the range");
+  EXPECT_EQ((runBladeRow<S, false>(row, ParticleKernel::Avx2).fault.particle), 13);
+  const int bits = int(sizeof(Raw<S>) * 8);
+  for (int rep = 0; rep < 400; ++rep) {  // random raw bits: mostly overflow, one particle a row
+    RowCase<S> r = bladeRow<S>(9, rng);
+    const int shift = 8 + rep % (bits - 8);
+    auto randomRaw = [&] { return S::fromRaw(Raw<S>(int64_t(rng()) >> (64 - shift))); };
+    const size_t i = size_t(rep) % 9;
+    for (auto* v : {&r.p.px, &r.p.py, &r.p.pz, &r.p.vx, &r.p.vy, &r.p.vz}) (*v)[i] = randomRaw();
+    if (rep % 3 == 0) r.p.anchorY[i] = randomRaw();
+    if (rep % 5 == 0) r.p.trample[i] = randomRaw();
+    expectBladeSameAsReference<S>(r, "random bits, rep " + std::to_string(rep));
+  }
+}
+
+TYPED_TEST(AvxKernel, BladeConstantsOutsideTheKernelsRangeRunTheReference) {
+  using S = TypeParam;
+  std::mt19937_64 rng(29);
+  RowCase<S> row = bladeRow<S>(40, rng);
+  row.c.bladeStiffnessDt = S::fromRaw(-row.c.bladeStiffnessDt.raw());
+  expectBladeSameAsReference<S>(row, "negative stiffness");
+  row = bladeRow<S>(40, rng);
+  row.c.bladeDampingPerTick = S(1);  // no damping at all: Fx32's wide product
+  expectBladeSameAsReference<S>(row, "damping 1");
+  row = bladeRow<S>(40, rng);
+  row.c.dt = S(2);
+  expectBladeSameAsReference<S>(row, "dt = 2 s");
+  row = bladeRow<S>(40, rng);
+  row.c.invRodLength = S::fromRaw(-1);
+  expectBladeSameAsReference<S>(row, "negative 1 / L");
 }
 
 // ---- the patch stage's AVX2 loops (sim/patches/patch_row_avx2.cpp) ----------------------------
@@ -570,10 +723,10 @@ struct WorldCase {
   const char* scenario;
   const char* scalar;
   int k;
-  bool pbd;
+  const char* model = "";  ///< "" keeps the scenario's grass model
 };
 void PrintTo(const WorldCase& c, std::ostream* os) {
-  *os << c.scenario << " " << c.scalar << " k=" << c.k << (c.pbd ? " pbd" : " thesis");
+  *os << c.scenario << " " << c.scalar << " k=" << c.k << " " << (*c.model ? c.model : "scenario's model");
 }
 
 class KernelWorlds : public ::testing::TestWithParam<WorldCase> {};
@@ -584,7 +737,7 @@ TEST_P(KernelWorlds, EveryTickHashEqualBetweenKernels) {
   Scenario s = loadScenarioFile(test::sourcePath(std::string("scenarios/") + c.scenario + ".json"));
   s.scalar = *parseScalarKind(c.scalar);
   s.particles.interpolation = c.k;
-  if (c.pbd) s.particles.model = GrassModel::Pbd;
+  if (*c.model) s.particles.model = std::string(c.model) == "pbd" ? GrassModel::Pbd : GrassModel::Blade;
   auto reference = makeWorld(s, 1);
   auto vector = makeWorld(s, 2);
   reference->setParticleKernel(ParticleKernel::Scalar);
@@ -606,14 +759,19 @@ TEST_P(KernelWorlds, EveryTickHashEqualBetweenKernels) {
 
 INSTANTIATE_TEST_SUITE_P(
     Scenarios, KernelWorlds,
-    ::testing::Values(WorldCase{"thesis-bodies", "fx32", 1, false}, WorldCase{"thesis-bodies", "fx16", 1, false},
-                      WorldCase{"thesis-bodies", "fx32", 2, true}, WorldCase{"thesis-bodies", "fx16", 2, true},
-                      WorldCase{"mower-field", "fx32", 2, false}, WorldCase{"mower-field", "fx16", 1, false},
-                      WorldCase{"lod-crossing", "fx32", 2, false}, WorldCase{"lod-crossing", "fx16", 4, false},
-                      WorldCase{"thesis-bodies", "fx32", 4, false}, WorldCase{"hilly-meadow", "fx16", 4, true}),
+    ::testing::Values(WorldCase{"thesis-bodies", "fx32", 1}, WorldCase{"thesis-bodies", "fx16", 1},
+                      WorldCase{"thesis-bodies", "fx32", 2, "pbd"}, WorldCase{"thesis-bodies", "fx16", 2, "pbd"},
+                      WorldCase{"mower-field", "fx32", 2}, WorldCase{"mower-field", "fx16", 1},
+                      WorldCase{"lod-crossing", "fx32", 2}, WorldCase{"lod-crossing", "fx16", 4},
+                      WorldCase{"thesis-bodies", "fx32", 4}, WorldCase{"hilly-meadow", "fx16", 4, "pbd"},
+                      // the blade model: trampled by bodies, gust fronts across the rows, a moving window
+                      WorldCase{"blade-bodies", "fx32", 1}, WorldCase{"blade-bodies", "fx16", 2},
+                      WorldCase{"wind-fronts", "fx32", 2}, WorldCase{"wind-fronts", "fx16", 1},
+                      WorldCase{"lod-crossing", "fx32", 2, "blade"}, WorldCase{"mower-field", "fx16", 4, "blade"}),
     [](const auto& info) {
       const WorldCase& c = info.param;
-      std::string n = std::string(c.scenario) + "_" + c.scalar + "_k" + std::to_string(c.k) + (c.pbd ? "_pbd" : "");
+      std::string n =
+          std::string(c.scenario) + "_" + c.scalar + "_k" + std::to_string(c.k) + (*c.model ? "_" : "") + c.model;
       for (char& ch : n)
         if (ch == '-') ch = '_';
       return n;

@@ -28,18 +28,20 @@
 #include <vector>
 
 #include "sim/math/scalar.h"
+#include "sim/particles/particle_kernel.h"
 #include "sim/particles/particles.h"
 #include "sim/patches/patch_state.h"
 
 namespace sg {
 
-/// Advances particles [begin, end) of one row under the blade model and writes the tip
-/// displacement p - anchor - (0, L, 0) into (dx, dy, dz). (dvx, dvy, dvz) is the row's
-/// (a + F/m) dt. Returns the first particle whose arithmetic faulted, or -1.
+/// The reference: advances particles [begin, end) of one row under the blade model and writes
+/// the tip displacement p - anchor - (0, L, 0) into (dx, dy, dz). (dvx, dvy, dvz) is the row's
+/// (a + F/m) dt. Returns the first particle whose arithmetic faulted, or -1 (the row then stops
+/// there: the particles after it are untouched and no displacement is written).
 template <class S, bool Tramples>
-inline int64_t advanceBladeRow(ParticleArrays<S>& p, int64_t begin, int64_t end, S dvx, S dvy, S dvz,
-                               const ParticleConstants<S>& c, std::vector<S>& dx, std::vector<S>& dy,
-                               std::vector<S>& dz) {
+inline int64_t advanceBladeRowScalar(ParticleArrays<S>& p, int64_t begin, int64_t end, S dvx, S dvy, S dvz,
+                                     const ParticleConstants<S>& c, std::vector<S>& dx, std::vector<S>& dy,
+                                     std::vector<S>& dz) {
   using T = ScalarTraits<S>;
   S* __restrict px = p.px.data();
   S* __restrict py = p.py.data();
@@ -96,6 +98,23 @@ inline int64_t advanceBladeRow(ParticleArrays<S>& p, int64_t begin, int64_t end,
   }
   particleDisplacement(p, begin, end, rod, dx, dy, dz);
   return -1;
+}
+
+/// The AVX2 kernel (Fx32 and Fx16 only; blade_row_avx2.cpp). Same contract and bits as
+/// advanceBladeRowScalar. Call only when avx2KernelAvailable().
+template <class S, bool Tramples>
+int64_t advanceBladeRowAvx2(ParticleArrays<S>& p, int64_t begin, int64_t end, S dvx, S dvy, S dvz,
+                            const ParticleConstants<S>& c, std::vector<S>& dx, std::vector<S>& dy, std::vector<S>& dz);
+
+/// The blade row with the chosen kernel (float and double always run the reference).
+template <class S, bool Tramples>
+inline int64_t advanceBladeRow(ParticleKernel kernel, ParticleArrays<S>& p, int64_t begin, int64_t end, S dvx, S dvy,
+                               S dvz, const ParticleConstants<S>& c, std::vector<S>& dx, std::vector<S>& dy,
+                               std::vector<S>& dz) {
+  if constexpr (ScalarTraits<S>::isFixed)
+    if (kernel == ParticleKernel::Avx2)
+      return advanceBladeRowAvx2<S, Tramples>(p, begin, end, dvx, dvy, dvz, c, dx, dy, dz);
+  return advanceBladeRowScalar<S, Tramples>(p, begin, end, dvx, dvy, dvz, c, dx, dy, dz);
 }
 
 }  // namespace sg

@@ -128,13 +128,13 @@ bool World<S>::integrateStage() {
   // fault.
   // One run of a row's particles [b, e) under one wind increment.
   const auto advance = [&](int64_t b, int64_t e, S dvx, S dvy, S dvz) -> RowFault {
+    const ParticleKernel kernel = particleKernel_;
     if (blade) {  // the blade kernel is one loop (blade.h): a fault is the integration's
-      const int64_t at = tramples
-                             ? advanceBladeRow<S, true>(particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_)
-                             : advanceBladeRow<S, false>(particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_);
+      const int64_t at =
+          tramples ? advanceBladeRow<S, true>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_)
+                   : advanceBladeRow<S, false>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_);
       return {at, Stage::Integrate};
     }
-    const ParticleKernel kernel = particleKernel_;
     return pbd ? advanceParticleRow<S, true>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_)
                : advanceParticleRow<S, false>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_);
   };
