@@ -23,6 +23,16 @@ class StageTimer final : public StageObserver {
   std::chrono::steady_clock::time_point start_;
 };
 
+/// The thesis meadow (tufts 0.1 m apart, the built-in scenario's wind) at side x side patches.
+inline Scenario plainMeadow(int64_t side, int k, ScalarKind scalar) {
+  Scenario s = parseScenario(defaultScenarioText(), "<built-in>", {});
+  s.field.patchesX = s.field.patchesZ = side;
+  s.field.spacing = Rational{1, 10};
+  s.particles.interpolation = k;
+  s.scalar = scalar;
+  return s;
+}
+
 /// A sphere of radius radiusCm cm resting on the ground at (x, z) m, rolling at (2, 0, 1) m/s.
 inline BodySpec rollingSphere(const char* name, int64_t radiusCm, int64_t x, int64_t z) {
   BodySpec b;

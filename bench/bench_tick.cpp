@@ -8,24 +8,16 @@
 #include <map>
 #include <memory>
 
+#include "bench/bench_support.h"
 #include "sim/world/world.h"
 
 namespace {
-
-sg::Scenario meadow(int64_t side, int k, sg::ScalarKind scalar) {
-  sg::Scenario s = sg::parseScenario(sg::defaultScenarioText(), "<built-in>", {});
-  s.field.patchesX = s.field.patchesZ = side;
-  s.field.spacing = sg::Rational{1, 10};
-  s.particles.interpolation = k;
-  s.scalar = scalar;
-  return s;
-}
 
 void BM_Tick(benchmark::State& state, sg::ScalarKind scalar) {
   const int64_t side = state.range(0);
   const int k = int(state.range(1));
   const int threads = int(state.range(2));
-  auto world = sg::makeWorld(meadow(side, k, scalar), threads);
+  auto world = sg::makeWorld(sg::bench::plainMeadow(side, k, scalar), threads);
   // Warm up past the initial transient so the wind is blowing on part of the field.
   for (int t = 0; t < 30; ++t) world->step(sg::TickInput{});
   for (auto _ : state) {
