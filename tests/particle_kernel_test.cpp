@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -43,7 +44,20 @@ struct RowCase {
 
 template <class S>
 S fromDouble(double v) {
-  return S::fromDouble(v);
+  if constexpr (ScalarTraits<S>::isFixed)
+    return S::fromDouble(v);
+  else
+    return S(v);
+}
+
+/// A value's bits: the raw integer of a fixed-point value, the IEEE pattern of a float or double
+/// (so that -0 and NaN payloads count too).
+template <class S>
+auto bitsOf(S v) {
+  if constexpr (ScalarTraits<S>::isFixed)
+    return v.raw();
+  else
+    return std::bit_cast<std::conditional_t<sizeof(S) == 4, uint32_t, uint64_t>>(v);
 }
 
 /// What one kernel did to a row.
@@ -70,9 +84,9 @@ RowResult<S> runRow(const RowCase<S>& in, ParticleKernel kernel) {
 }
 
 template <class S>
-std::vector<Raw<S>> raws(const std::vector<S>& v) {
-  std::vector<Raw<S>> out;
-  for (S s : v) out.push_back(s.raw());
+auto raws(const std::vector<S>& v) {
+  std::vector<decltype(bitsOf(S{}))> out;
+  for (S x : v) out.push_back(bitsOf(x));
   return out;
 }
 
@@ -99,7 +113,10 @@ void expectSameAsReference(const RowCase<S>& in, const std::string& what) {
 template <class S>
 ParticleConstants<S> thesisConstants(double rod = 0.5) {
   ParticleConstants<S> c;
-  c.dt = S::fromRaw(Raw<S>((int64_t(1) << S::kFracBits) / 60));
+  if constexpr (ScalarTraits<S>::isFixed)
+    c.dt = S::fromRaw(Raw<S>((int64_t(1) << S::kFracBits) / 60));
+  else
+    c.dt = S(1) / S(60);
   c.invDt = S(60);
   c.dampingPerTick = fromDouble<S>(0.9885);
   c.rodLength = fromDouble<S>(rod);
@@ -424,6 +441,104 @@ TYPED_TEST(AvxKernel, ConstantsOutsideTheKernelsRangeRunTheReference) {
   expectSameAsReference<S, false>(row, "dt = 2 s");
 }
 
+// ---- float and double: the particle pass's IEEE lanes ----------------------------------------
+
+template <class F>
+class AvxFloatKernel : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!avx2KernelAvailable()) GTEST_SKIP() << "this CPU has no AVX2: the world runs the reference only";
+  }
+};
+using FloatScalars = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(AvxFloatKernel, FloatScalars);
+
+TYPED_TEST(AvxFloatKernel, RealisticRowsOfEveryLengthMatchTheReference) {
+  using F = TypeParam;
+  std::mt19937_64 rng(31);
+  for (size_t n = 0; n <= 37; ++n) {
+    const RowCase<F> row = realisticRow<F>(n, rng);
+    expectSameAsReference<F, false>(row, "thesis, n = " + std::to_string(n));
+    expectSameAsReference<F, true>(row, "pbd, n = " + std::to_string(n));
+  }
+  for (int rep = 0; rep < 20; ++rep) {
+    const RowCase<F> row = realisticRow<F>(1001, rng, rep % 2 ? 0.2 : 30.0);
+    expectSameAsReference<F, false>(row, "thesis, long row " + std::to_string(rep));
+    expectSameAsReference<F, true>(row, "pbd, long row " + std::to_string(rep));
+  }
+}
+
+/// A value drawn from what IEEE arithmetic treats specially: zeros of both signs, denormals,
+/// the largest finite values (whose squares and sums overflow), infinities, NaN, or any bits.
+template <class F>
+F specialValue(std::mt19937_64& rng) {
+  using L = std::numeric_limits<F>;
+  using U = std::conditional_t<sizeof(F) == 4, uint32_t, uint64_t>;
+  const F sign = rng() % 2 ? F(1) : F(-1);
+  switch (rng() % 9) {
+    case 0:
+      return sign * F(0);
+    case 1:
+      return sign * L::denorm_min() * F(double(rng() % 1000));
+    case 2:
+      return sign * L::max() / F(double(1 + rng() % 4));
+    case 3:
+      return sign * L::infinity();
+    case 4:
+      return L::quiet_NaN();
+    case 5:
+      return std::bit_cast<F>(U(rng()));
+    case 6:
+      return sign * std::sqrt(L::max()) * F(double(rng() % 3));  // squares near the overflow
+    default:
+      return sign * F(double(rng() % 2000) / 1000.0);
+  }
+}
+
+TYPED_TEST(AvxFloatKernel, SpecialValuesMatchTheReference) {
+  using F = TypeParam;
+  std::mt19937_64 rng(37);
+  for (int rep = 0; rep < 4000; ++rep) {
+    RowCase<F> row = realisticRow<F>(9 + size_t(rep) % 8, rng);
+    const size_t i = size_t(rep) % 9;
+    const unsigned mask = unsigned(rng());
+    std::vector<F>* fields[] = {&row.p.px, &row.p.py,      &row.p.pz,      &row.p.vx,     &row.p.vy,
+                                &row.p.vz, &row.p.anchorX, &row.p.anchorY, &row.p.anchorZ};
+    for (size_t f = 0; f < std::size(fields); ++f)
+      if (mask & (1u << f)) (*fields[f])[i] = specialValue<F>(rng);
+    if (mask & 512) {  // the tip exactly at its anchor (the reference stands it upright)
+      row.p.px[i] = row.p.anchorX[i];
+      row.p.py[i] = row.p.anchorY[i];
+      row.p.pz[i] = row.p.anchorZ[i];
+      row.p.vx[i] = row.p.vy[i] = row.p.vz[i] = F(0);
+      row.dvx = row.dvy = row.dvz = F(0);
+    }
+    if (mask & 1024) row.dvy = specialValue<F>(rng);
+    expectSameAsReference<F, false>(row, "thesis, rep " + std::to_string(rep));
+    expectSameAsReference<F, true>(row, "pbd, rep " + std::to_string(rep));
+    if (::testing::Test::HasFailure()) return;
+  }
+}
+
+TYPED_TEST(AvxFloatKernel, IntegrationFaultLaterInTheRowIsReportedBeforeAProjectionFault) {
+  using F = TypeParam;
+  std::mt19937_64 rng(41);
+  RowCase<F> row = realisticRow<F>(24, rng);
+  // Particle 2: finite after integration, but p - anchor overflows to infinity, so the projected
+  // tip is inf * 0 = NaN (a projection fault).
+  row.p.anchorX[2] = std::numeric_limits<F>::lowest();
+  row.p.px[2] = std::numeric_limits<F>::max();
+  row.p.vx[2] = F(0);
+  expectSameAsReference<F, false>(row, "projection only");
+  EXPECT_EQ((runRow<F, false>(row, ParticleKernel::Avx2).fault.particle), 2);
+  EXPECT_EQ(int(runRow<F, false>(row, ParticleKernel::Avx2).fault.stage), int(Stage::Constraints));
+  row.p.vx[19] = std::numeric_limits<F>::infinity();  // an integration fault later in the row
+  expectSameAsReference<F, false>(row, "projection fault at 2, integration fault at 19");
+  const RowResult<F> vec = runRow<F, false>(row, ParticleKernel::Avx2);
+  EXPECT_EQ(vec.fault.particle, 19);
+  EXPECT_EQ(int(vec.fault.stage), int(Stage::Integrate));
+}
+
 // ---- the blade model's row (sim/particles/blade_row_avx2.cpp) ---------------------------------
 
 /// The blade constants of a 1.5 Hz blade, damping ratio 0.3, trampled for 2 s, at 60 Hz.
@@ -705,6 +820,52 @@ TYPED_TEST(AvxKernel, PatchWritesMatchWriteFast) {
   }
 }
 
+TYPED_TEST(AvxFloatKernel, PatchWritesMatchTheReference) {
+  using F = TypeParam;
+  std::mt19937_64 rng(43);
+  const size_t n = 3001;
+  PatchArrays<F> ref, vec;
+  for (PatchArrays<F>* a : {&ref, &vec}) {
+    a->tipOffsetX.assign(n, F(0));
+    a->tipOffsetZ.assign(n, F(0));
+    a->topY.assign(n, F(0));
+    a->tiltLevel.assign(n, 0);
+    a->rootY.resize(n);
+    a->cut.resize(n);
+  }
+  std::vector<F> dx(n), dy(n), dz(n);
+  for (size_t i = 0; i < n; ++i) {
+    ref.rootY[i] = vec.rootY[i] = i % 7 == 0 ? specialValue<F>(rng) : F(double(i % 13) / 10.0);
+    ref.cut[i] = vec.cut[i] = uint8_t(i % 3 == 0 ? (i % 2 ? 1 : 200) : 0);  // any non-zero byte is "cut"
+    dx[i] = specialValue<F>(rng);
+    dz[i] = specialValue<F>(rng);
+    // dy: mostly around the drops and the half rod (and both zeros), sometimes special
+    dy[i] = i % 4 == 0 ? specialValue<F>(rng) : i % 4 == 1 ? F(-0.0) : F(-0.3 + 0.6 * double(i % 101) / 100.0);
+  }
+  PatchStateConstants<F> c;
+  c.halfRod = F(0.25);
+  c.scaleY = F(0.4);
+  c.cutReduction = F(0.3);
+  c.minimumTop = F(0.05);
+  c.drop[0] = F(0.05);
+  c.drop[1] = F(0.1);
+  c.drop[2] = F(0.2);
+  for (int variant = 0; variant < 3; ++variant) {
+    if (variant == 1) c.halfRod = F(-0.1);              // a negative bound: "smaller" is still the reference's
+    if (variant == 2) std::swap(c.drop[0], c.drop[2]);  // falling drops: the if-chain, not a count
+    const PatchWriter<F> wr(ref, c), wv(vec, c);
+    for (size_t first : {size_t(0), size_t(3)}) {
+      const int64_t count = int64_t(n - first - 1);
+      for (int64_t q = 0; q < count; ++q) wr.write(first + size_t(q), dx[size_t(q)], dy[size_t(q)], dz[size_t(q)]);
+      writePatchesAvx2(wv, first, dx.data(), dy.data(), dz.data(), count);
+      EXPECT_EQ(raws(vec.tipOffsetX), raws(ref.tipOffsetX)) << "variant " << variant;
+      EXPECT_EQ(raws(vec.tipOffsetZ), raws(ref.tipOffsetZ)) << "variant " << variant;
+      EXPECT_EQ(raws(vec.topY), raws(ref.topY)) << "variant " << variant;
+      EXPECT_EQ(vec.tiltLevel, ref.tiltLevel) << "variant " << variant;
+    }
+  }
+}
+
 // ---- whole worlds ---------------------------------------------------------------------------
 
 /// The derived patch state (not in the state hash: it is recomputed from the particles) of two
@@ -750,10 +911,20 @@ TEST_P(KernelWorlds, EveryTickHashEqualBetweenKernels) {
     ASSERT_TRUE(reference->step(in).ok) << "tick " << t;
     ASSERT_TRUE(vector->step(in).ok) << "tick " << t;
     ASSERT_EQ(reference->stateHash(), vector->stateHash()) << c.scenario << " " << c.scalar << " tick " << t;
-    if (s.scalar == ScalarKind::Fx32)
-      expectSamePatches<Fx32>(*reference, *vector, t);
-    else
-      expectSamePatches<Fx16>(*reference, *vector, t);
+    switch (s.scalar) {
+      case ScalarKind::Fx32:
+        expectSamePatches<Fx32>(*reference, *vector, t);
+        break;
+      case ScalarKind::Fx16:
+        expectSamePatches<Fx16>(*reference, *vector, t);
+        break;
+      case ScalarKind::Float:
+        expectSamePatches<float>(*reference, *vector, t);
+        break;
+      case ScalarKind::Double:
+        expectSamePatches<double>(*reference, *vector, t);
+        break;
+    }
   }
 }
 
@@ -767,7 +938,11 @@ INSTANTIATE_TEST_SUITE_P(
                       // the blade model: trampled by bodies, gust fronts across the rows, a moving window
                       WorldCase{"blade-bodies", "fx32", 1}, WorldCase{"blade-bodies", "fx16", 2},
                       WorldCase{"wind-fronts", "fx32", 2}, WorldCase{"wind-fronts", "fx16", 1},
-                      WorldCase{"lod-crossing", "fx32", 2, "blade"}, WorldCase{"mower-field", "fx16", 4, "blade"}),
+                      WorldCase{"lod-crossing", "fx32", 2, "blade"}, WorldCase{"mower-field", "fx16", 4, "blade"},
+                      // float and double: the particle pass's IEEE lanes
+                      WorldCase{"thesis-bodies", "float", 1}, WorldCase{"thesis-bodies", "double", 2, "pbd"},
+                      WorldCase{"lod-crossing", "float", 2}, WorldCase{"mower-field", "double", 1},
+                      WorldCase{"hilly-meadow", "float", 4, "pbd"}, WorldCase{"blade-bodies", "double", 2}),
     [](const auto& info) {
       const WorldCase& c = info.param;
       std::string n =

@@ -97,12 +97,15 @@ int runScenario(const RunOptions& o) {
     j["scalar"] = scalarName(scenario.scalar);
     j["interpolation"] = counts.interpolation;
     j["threads"] = counts.threads;
-    // The blade model's particle pass has only the scalar reference (sim/particles/blade.h); the
-    // patch stage still runs the chosen kernel.
+    // What ran where the world chose AVX2 (docs/performance.md, "Vector kernels"): the particle
+    // pass has AVX2 lanes in every scalar except the blade model's row in float and double; the
+    // patch stage's writes in every scalar (float and double interpolate k > 1 with scalar loops).
+    const bool fixed = scenario.scalar == ScalarKind::Fx32 || scenario.scalar == ScalarKind::Fx16;
     const bool blade = scenario.particles.model == GrassModel::Blade;
+    const char* chosen = particleKernelName(world->particleKernel());
     j["model"] = grassModelName(scenario.particles.model);
-    j["kernel"] = blade ? "scalar" : particleKernelName(world->particleKernel());
-    j["patchKernel"] = particleKernelName(world->particleKernel());
+    j["kernel"] = blade && !fixed ? "scalar" : chosen;
+    j["patchKernel"] = chosen;
     j["counts"] = {{"patchesX", counts.patchesX},     {"patchesZ", counts.patchesZ},
                    {"patches", counts.patches()},     {"particlesX", counts.particlesX},
                    {"particlesZ", counts.particlesZ}, {"particles", counts.particles()},
@@ -186,8 +189,8 @@ void addRunCommand(CLI::App& app, int* exitCode) {
   run->add_option("--lod", opts->lod, "Level of detail: off (the whole field) or window (around the camera)")
       ->check(CLI::IsMember({"off", "window"}));
   run->add_option("--kernel", opts->kernel,
-                  "Particle pass: auto (AVX2 where the CPU has it, for fx32/fx16), scalar (the reference) or avx2 "
-                  "(the state is identical)")
+                  "Particle pass and patch stage: auto (AVX2 where the CPU has it), scalar (the reference) or avx2 "
+                  "(the state is identical; --json's kernel and patchKernel say what ran)")
       ->check(CLI::IsMember({"auto", "scalar", "avx2"}));
   run->add_flag("--json", opts->json, "Machine-readable output");
   run->callback([opts, exitCode] { *exitCode = runScenario(*opts); });

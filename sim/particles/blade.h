@@ -106,7 +106,7 @@ template <class S, bool Tramples>
 int64_t advanceBladeRowAvx2(ParticleArrays<S>& p, int64_t begin, int64_t end, S dvx, S dvy, S dvz,
                             const ParticleConstants<S>& c, std::vector<S>& dx, std::vector<S>& dy, std::vector<S>& dz);
 
-/// The blade row with the chosen kernel (float and double always run the reference).
+/// The blade row with the chosen kernel (float and double run the reference: no IEEE lanes yet).
 template <class S, bool Tramples>
 inline int64_t advanceBladeRow(ParticleKernel kernel, ParticleArrays<S>& p, int64_t begin, int64_t end, S dvx, S dvy,
                                S dvz, const ParticleConstants<S>& c, std::vector<S>& dx, std::vector<S>& dy,

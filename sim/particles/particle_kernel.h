@@ -7,9 +7,10 @@
 namespace sg {
 
 /// Which implementation of the hot loops a world runs: the fused particle pass
-/// (particles/particle_row.h) and the patch stage's loops (patches/patch_row_avx2.cpp). Both give
-/// bit-identical state and the same fault reports; Avx2 applies to the fixed-point scalars on CPUs
-/// that have it.
+/// (particles/particle_row.h, blade.h) and the patch stage's loops (patches/patch_row_avx2.cpp).
+/// Both give bit-identical state and the same fault reports. Avx2, on CPUs that have it, covers
+/// the thesis and pbd particle pass in every scalar, and the blade row and the patch stage in the
+/// fixed-point scalars (float and double run their scalar references there).
 enum class ParticleKernel : uint8_t { Scalar = 0, Avx2 = 1 };
 
 /// "scalar" or "avx2".

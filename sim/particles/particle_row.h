@@ -7,9 +7,9 @@
 // 1,000,000 patches, k = 2) stay in L1/L2 between them instead of streaming the whole particle
 // state (18 MB there) through memory three times (docs/performance.md, "Fused particle pass").
 //
-// Two implementations give the same bits: the scalar reference below, and for the fixed-point
-// scalars an AVX2 kernel (particle_row_avx2.cpp) that runs four (Fx32) or eight (Fx16) particles
-// per instruction and hands any block it cannot prove exact to the reference (docs/performance.md,
+// Two implementations give the same bits: the scalar reference below, and an AVX2 kernel
+// (particle_row_avx2.cpp) that runs four (Fx32, double) or eight (Fx16, float) particles per
+// instruction and hands any block it cannot prove exact to the reference (docs/performance.md,
 // "Vector kernels").
 #pragma once
 
@@ -45,21 +45,20 @@ inline RowFault advanceParticleRowScalar(ParticleArrays<S>& p, int64_t begin, in
   return {};
 }
 
-/// The AVX2 kernel (Fx32 and Fx16 only; particle_row_avx2.cpp). Same contract and bits as
+/// The AVX2 kernel (every scalar; particle_row_avx2.cpp). Same contract and bits as
 /// advanceParticleRowScalar. Call only when avx2KernelAvailable().
 template <class S, bool Pbd>
 RowFault advanceParticleRowAvx2(ParticleArrays<S>& p, int64_t begin, int64_t end, S dvx, S dvy, S dvz,
                                 const ParticleConstants<S>& c, std::vector<S>& dx, std::vector<S>& dy,
                                 std::vector<S>& dz);
 
-/// The fused pass with the chosen kernel (float and double always run the reference).
+/// The fused pass with the chosen kernel.
 template <class S, bool Pbd>
 inline RowFault advanceParticleRow(ParticleKernel kernel, ParticleArrays<S>& p, int64_t begin, int64_t end, S dvx,
                                    S dvy, S dvz, const ParticleConstants<S>& c, std::vector<S>& dx, std::vector<S>& dy,
                                    std::vector<S>& dz) {
-  if constexpr (ScalarTraits<S>::isFixed)
-    if (kernel == ParticleKernel::Avx2)
-      return advanceParticleRowAvx2<S, Pbd>(p, begin, end, dvx, dvy, dvz, c, dx, dy, dz);
+  if (kernel == ParticleKernel::Avx2)
+    return advanceParticleRowAvx2<S, Pbd>(p, begin, end, dvx, dvy, dvz, c, dx, dy, dz);
   return advanceParticleRowScalar<S, Pbd>(p, begin, end, dvx, dvy, dvz, c, dx, dy, dz);
 }
 

@@ -1,6 +1,7 @@
-// The fused particle pass (particle_row.h) for Fx32 and Fx16 in AVX2, with the reference's
-// exact bits: Fx32 four particles per block (one Q32.32 value per 64-bit lane), Fx16 eight
-// (one Q16.16 value per 32-bit lane). The exact lane arithmetic is avx2_fixed.h's.
+// The fused particle pass (particle_row.h) in AVX2, with the reference's exact bits: Fx32 four
+// particles per block (one Q32.32 value per 64-bit lane), Fx16 eight (one Q16.16 value per
+// 32-bit lane), float eight and double four (IEEE lanes). The exact fixed-point lane arithmetic
+// is avx2_fixed.h's.
 //
 // How it stays exact (docs/performance.md, "Vector kernels"): every product, sum, root and
 // quotient either has Fixed's bits or flags its lane (avx2_fixed.h). A block with any lane
@@ -14,6 +15,7 @@
 #include <type_traits>
 
 #include "sim/particles/avx2_fixed.h"
+#include "sim/particles/avx2_ieee.h"
 #include "sim/particles/particle_row.h"
 
 namespace sg {
@@ -186,6 +188,84 @@ __attribute__((target("avx2"))) bool advanceBlock(ParticleArrays<Fx16>& p, int64
 
 }  // namespace q16
 
+// ---- float and double: eight or four particles per block ----------------------------------
+// The blocks compute the reference's operations in its order in IEEE lanes (avx2_ieee.h), so
+// they give its bits; MXCSR (rounding, denormals) is shared by scalar and vector instructions. A block
+// with a non-finite value after the projection (which every integration fault and every tip at
+// its anchor lead to) runs the reference, which reports the fault or stands the tip upright.
+namespace ieee {
+
+template <class F>
+using Simd = avx2::IeeeLanes<F>;
+
+template <class F>
+struct RowConstants {
+  typename Simd<F>::V dt, damping, invDt, dvx, dvy, dvz, rod;
+};
+
+template <class F>
+__attribute__((target("avx2"))) bool makeRowConstants(const ParticleConstants<F>& c, F dvx, F dvy, F dvz,
+                                                      RowConstants<F>& k) {
+  using W = Simd<F>;
+  k = {W::all(c.dt), W::all(c.dampingPerTick), W::all(c.invDt), W::all(dvx), W::all(dvy),
+       W::all(dvz),  W::all(c.rodLength)};
+  return true;
+}
+
+/// Particles [i, i + lanes), the reference's operations in its order (integrate.h,
+/// rod_constraint.h, patch_state.h's particleDisplacement). Returns false, having written
+/// nothing, when the block needs the reference.
+template <class F, bool Pbd>
+__attribute__((target("avx2"))) bool advanceBlock(ParticleArrays<F>& p, int64_t i, const RowConstants<F>& k, F* outX,
+                                                  F* outY, F* outZ) {
+  using W = Simd<F>;
+  using V = typename W::V;
+  V px = W::load(&p.px[i]), py = W::load(&p.py[i]), pz = W::load(&p.pz[i]);
+  V vx = W::load(&p.vx[i]), vy = W::load(&p.vy[i]), vz = W::load(&p.vz[i]);
+  if constexpr (!Pbd) {
+    px = W::add(px, W::mul(vx, k.dt));
+    py = W::add(py, W::mul(vy, k.dt));
+    pz = W::add(pz, W::mul(vz, k.dt));
+  }
+  vx = W::mul(W::add(vx, k.dvx), k.damping);
+  vy = W::mul(W::add(vy, k.dvy), k.damping);
+  vz = W::mul(W::add(vz, k.dvz), k.damping);
+  if constexpr (Pbd) {
+    px = W::add(px, W::mul(vx, k.dt));
+    py = W::add(py, W::mul(vy, k.dt));
+    pz = W::add(pz, W::mul(vz, k.dt));
+  }
+  const V ax = W::load(&p.anchorX[i]), ay = W::load(&p.anchorY[i]), az = W::load(&p.anchorZ[i]);
+  const V dx = W::sub(px, ax), dy = W::sub(py, ay), dz = W::sub(pz, az);
+  const V len = W::sqrt(W::add(W::add(W::mul(dx, dx), W::mul(dy, dy)), W::mul(dz, dz)));  // length3
+  const V scale = W::div(k.rod, len);
+  const V nx = W::add(ax, W::mul(dx, scale)), ny = W::add(ay, W::mul(dy, scale)), nz = W::add(az, W::mul(dz, scale));
+  if constexpr (Pbd) {  // v += (p_new - p) / dt
+    vx = W::add(vx, W::mul(W::sub(nx, px), k.invDt));
+    vy = W::add(vy, W::mul(W::sub(ny, py), k.invDt));
+    vz = W::add(vz, W::mul(W::sub(nz, pz), k.invDt));
+  }
+  // One check covers every case the reference handles apart: a non-finite value after
+  // integration stays non-finite through the projection (an infinite d gives inf * 0 = NaN; the
+  // velocity is kept or grows), and a tip at its anchor (length 0, which the reference stands
+  // upright) gives 0 * (L / 0) = NaN. Removing the check makes the tests fail; the early checks
+  // it replaces were each removed in turn and no test could tell.
+  if (!W::finite(nx, ny, nz) || !W::finite(vx, vy, vz)) return false;
+  W::store(&p.px[i], nx);
+  W::store(&p.py[i], ny);
+  W::store(&p.pz[i], nz);
+  W::store(&p.vx[i], vx);
+  W::store(&p.vy[i], vy);
+  W::store(&p.vz[i], vz);
+  // Tip displacement p - anchor - (0, L, 0), in the reference's order ((p - a) - L).
+  W::store(outX + i, W::sub(nx, ax));
+  W::store(outY + i, W::sub(W::sub(ny, ay), k.rod));
+  W::store(outZ + i, W::sub(nz, az));
+  return true;
+}
+
+}  // namespace ieee
+
 // ---- one row ----------------------------------------------------------------------------------
 
 template <class S>
@@ -200,6 +280,12 @@ struct Lanes<Fx16> {
   static constexpr int kBlock = 8;
   using Constants = q16::RowConstants;
 };
+template <class F>
+requires std::is_floating_point_v<F>
+struct Lanes<F> {
+  static constexpr int kBlock = ieee::Simd<F>::kCount;
+  using Constants = ieee::RowConstants<F>;
+};
 
 template <class S, bool Pbd, bool Narrow>
 __attribute__((target("avx2"))) RowFault advanceRow(ParticleArrays<S>& p, int64_t begin, int64_t end, S dvx, S dvy,
@@ -210,8 +296,10 @@ __attribute__((target("avx2"))) RowFault advanceRow(ParticleArrays<S>& p, int64_
   bool handled;
   if constexpr (std::is_same_v<S, Fx32>)
     handled = q32::makeRowConstants(c, dvx, dvy, dvz, k);
-  else
+  else if constexpr (std::is_same_v<S, Fx16>)
     handled = q16::makeRowConstants(c, dvx, dvy, dvz, k);
+  else
+    handled = ieee::makeRowConstants<S>(c, dvx, dvy, dvz, k);
   if (ScalarTraits<S>::faultPending() || !handled)
     return advanceParticleRowScalar<S, Pbd>(p, begin, end, dvx, dvy, dvz, c, dx, dy, dz);
   int64_t i = begin;
@@ -219,8 +307,10 @@ __attribute__((target("avx2"))) RowFault advanceRow(ParticleArrays<S>& p, int64_
     bool done;
     if constexpr (std::is_same_v<S, Fx32>)
       done = q32::advanceBlock<Pbd, Narrow>(p, i, k, dx.data(), dy.data(), dz.data());
-    else
+    else if constexpr (std::is_same_v<S, Fx16>)
       done = q16::advanceBlock<Pbd>(p, i, k, dx.data(), dy.data(), dz.data());
+    else
+      done = ieee::advanceBlock<S, Pbd>(p, i, k, dx.data(), dy.data(), dz.data());
     if (done) continue;
     // The reference for this block. Particles are independent, so the state is the same as if
     // the whole row ran the reference; only a fault needs care: the reference integrates the
@@ -289,5 +379,9 @@ SG_INSTANTIATE_AVX2_ROW(Fx32, false)
 SG_INSTANTIATE_AVX2_ROW(Fx32, true)
 SG_INSTANTIATE_AVX2_ROW(Fx16, false)
 SG_INSTANTIATE_AVX2_ROW(Fx16, true)
+SG_INSTANTIATE_AVX2_ROW(float, false)
+SG_INSTANTIATE_AVX2_ROW(float, true)
+SG_INSTANTIATE_AVX2_ROW(double, false)
+SG_INSTANTIATE_AVX2_ROW(double, true)
 
 }  // namespace sg

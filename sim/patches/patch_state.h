@@ -192,6 +192,12 @@ void interpolateQuartersAvx2(const S* r, S* out, int64_t quads);
 /// w.writeFast(first + q, dx[q], dy[q], dz[q]) for q in [0, count).
 template <class S>
 void writePatchesAvx2(const PatchWriter<S>& w, size_t first, const S* dx, const S* dy, const S* dz, int64_t count);
+/// w.write(first + q, ...) for float and double (patch_write_ieee_avx2.cpp): IEEE lanes, the
+/// reference's operations and ordered comparisons, so its bits (NaN and signed zeros included).
+void writePatchesAvx2(const PatchWriter<float>& w, size_t first, const float* dx, const float* dy, const float* dz,
+                      int64_t count);
+void writePatchesAvx2(const PatchWriter<double>& w, size_t first, const double* dx, const double* dy, const double* dz,
+                      int64_t count);
 
 /// t / K as a constant, for K a power of two: exact in every scalar (the runtime weight
 /// c.weight[t] holds the same value; rowWeightsAreExact checks), so the compiler turns the
@@ -330,7 +336,7 @@ inline void updatePatchRow(PatchArrays<S>& patches, const LatticeWindow& patchWi
   }
   const PatchWriter<S> out(patches, c);
   const size_t rowBase = size_t(patchWindow.storageRow(j) * rowSize);
-  if constexpr (kFast)
+  if constexpr (kFast || !ScalarTraits<S>::isFixed)
     if (vector) return writePatchesAvx2(out, rowBase, qx, qy, qz, rowSize);
   for (int64_t q = 0; q < rowSize; ++q) {
     if constexpr (kFast)

@@ -50,7 +50,7 @@ class World final : public SimWorld {
   void restoreState(std::span<const uint8_t> bytes) override;
   void setThreads(int threads) override;
   void setParticleKernel(ParticleKernel kernel) override {
-    const bool vector = ScalarTraits<S>::isFixed && kernel == ParticleKernel::Avx2 && avx2KernelAvailable();
+    const bool vector = kernel == ParticleKernel::Avx2 && avx2KernelAvailable();
     particleKernel_ = vector ? ParticleKernel::Avx2 : ParticleKernel::Scalar;
   }
   ParticleKernel particleKernel() const override { return particleKernel_; }
@@ -119,7 +119,7 @@ class World final : public SimWorld {
   uint64_t configHash_ = 0;
   GrassModel model_ = GrassModel::Thesis;
   /// The fused particle pass's implementation (float and double: always the reference).
-  ParticleKernel particleKernel_ = ScalarTraits<S>::isFixed ? defaultParticleKernel() : ParticleKernel::Scalar;
+  ParticleKernel particleKernel_ = defaultParticleKernel();
   GrassLattice<S> lattice_;
   PatchArrays<S> patches_;
   LatticeWindow patchWindow_;  ///< which patches patches_ holds (toroidal, like the particles)

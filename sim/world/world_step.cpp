@@ -27,9 +27,8 @@ void World<S>::updatePatchesFromDisplacement() {
     pool_->run((grid_.countZ + rowsPerChunk_ - 1) / rowsPerChunk_, [&](int64_t c, int) {
       const int64_t q0 = c * rowsPerChunk_ * grid_.countX;
       const int64_t q1 = std::min(grid_.countZ, (c + 1) * rowsPerChunk_) * grid_.countX;
-      if constexpr (ScalarTraits<S>::isFixed)
-        if (particleKernel_ == ParticleKernel::Avx2)
-          return writePatchesAvx2(out, size_t(q0), dx + q0, dy + q0, dz + q0, q1 - q0);
+      if (particleKernel_ == ParticleKernel::Avx2)
+        return writePatchesAvx2(out, size_t(q0), dx + q0, dy + q0, dz + q0, q1 - q0);
       for (int64_t q = q0; q < q1; ++q)
         out.writeFast(size_t(q), dx[q], dy[q], dz[q]);  // same bits as write(): patch_state.h
     });
