@@ -111,6 +111,17 @@ TEST(CliRun, HashIsIndependentOfTheParticleKernel) {
       runCli("run " + scenarioPath("blade-bodies.json") + " --ticks 2 --json --scalar fx16 --kernel avx2");
   ASSERT_EQ(fxb.exitCode, 0) << fxb.describe();
   EXPECT_EQ(parseJson(fxb).value("kernel", ""), sg::avx2KernelAvailable() ? "avx2" : "scalar");
+  // The text output names the same kernels.
+  const CliResult text = runCli("run " + scenarioPath("blade-bodies.json") + " --ticks 2 --scalar fx16 --kernel avx2");
+  ASSERT_EQ(text.exitCode, 0) << text.describe();
+  const std::string vectorName = sg::avx2KernelAvailable() ? "avx2" : "scalar";
+  EXPECT_NE(text.out.find(vectorName + " blade kernel, " + vectorName + " patch kernel"), std::string::npos)
+      << text.describe();
+  const CliResult floatText =
+      runCli("run " + scenarioPath("blade-bodies.json") + " --ticks 2 --scalar float --kernel avx2");
+  ASSERT_EQ(floatText.exitCode, 0) << floatText.describe();
+  EXPECT_NE(floatText.out.find("scalar blade kernel, " + vectorName + " patch kernel"), std::string::npos)
+      << floatText.describe();
   const CliResult fxp = runCli("run --ticks 2 --json --scalar float --kernel avx2");
   ASSERT_EQ(fxp.exitCode, 0) << fxp.describe();
   EXPECT_EQ(parseJson(fxp).value("patchKernel", ""), sg::avx2KernelAvailable() ? "avx2" : "scalar");

@@ -90,6 +90,14 @@ int runScenario(const RunOptions& o) {
   const double msPerTick = ran > 0 ? seconds * 1e3 / double(ran) : 0.0;
   const double patchSteps = ran > 0 ? double(counts.patches()) * double(ran) / seconds : 0.0;
 
+  // What ran where the world chose AVX2 (docs/performance.md, "Vector kernels"): the particle
+  // pass has AVX2 lanes in every scalar except the blade model's row in float and double; the
+  // patch stage's writes in every scalar (float and double interpolate k > 1 with scalar loops).
+  const bool fixed = scenario.scalar == ScalarKind::Fx32 || scenario.scalar == ScalarKind::Fx16;
+  const bool blade = scenario.particles.model == GrassModel::Blade;
+  const char* patchKernel = particleKernelName(world->particleKernel());
+  const char* particleKernel = blade && !fixed ? "scalar" : patchKernel;
+
   if (o.json) {
     nlohmann::json j;
     j["scenario"] = scenario.name;
@@ -97,15 +105,9 @@ int runScenario(const RunOptions& o) {
     j["scalar"] = scalarName(scenario.scalar);
     j["interpolation"] = counts.interpolation;
     j["threads"] = counts.threads;
-    // What ran where the world chose AVX2 (docs/performance.md, "Vector kernels"): the particle
-    // pass has AVX2 lanes in every scalar except the blade model's row in float and double; the
-    // patch stage's writes in every scalar (float and double interpolate k > 1 with scalar loops).
-    const bool fixed = scenario.scalar == ScalarKind::Fx32 || scenario.scalar == ScalarKind::Fx16;
-    const bool blade = scenario.particles.model == GrassModel::Blade;
-    const char* chosen = particleKernelName(world->particleKernel());
     j["model"] = grassModelName(scenario.particles.model);
-    j["kernel"] = blade && !fixed ? "scalar" : chosen;
-    j["patchKernel"] = chosen;
+    j["kernel"] = particleKernel;
+    j["patchKernel"] = patchKernel;
     j["counts"] = {{"patchesX", counts.patchesX},     {"patchesZ", counts.patchesZ},
                    {"patches", counts.patches()},     {"particlesX", counts.particlesX},
                    {"particlesZ", counts.particlesZ}, {"particles", counts.particles()},
@@ -130,10 +132,8 @@ int runScenario(const RunOptions& o) {
   } else {
     std::printf("scenario   %s (%s)\n", escapeControl(scenario.name).c_str(),
                 escapeControl(scenario.sourceName).c_str());
-    const bool blade = scenario.particles.model == GrassModel::Blade;
-    const std::string kernelText =
-        blade ? std::string("scalar blade kernel, ") + particleKernelName(world->particleKernel()) + " patch kernel"
-              : std::string(particleKernelName(world->particleKernel())) + " particle kernel";
+    const std::string kernelText = std::string(particleKernel) + (blade ? " blade kernel, " : " particle kernel, ") +
+                                   patchKernel + " patch kernel";
     std::printf("scalar     %s, interpolation k=%d, %d thread%s, %s\n", scalarName(scenario.scalar),
                 counts.interpolation, counts.threads, counts.threads == 1 ? "" : "s", kernelText.c_str());
     std::printf(
