@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "bench/bench_support.h"
 #include "sim/world/chunk_pool.h"
 #include "sim/world/settings.h"
 
@@ -149,8 +150,7 @@ void BM_AosPeer(benchmark::State& state) {
     tickMs.push_back(s * 1e3);
     state.SetIterationTime(s);
   }
-  std::sort(tickMs.begin(), tickMs.end());
-  state.counters["tick_ms"] = tickMs.empty() ? 0 : tickMs[tickMs.size() / 2];
+  state.counters["tick_ms"] = sg::bench::quantile(tickMs, 0.5);
   state.counters["patches"] = double(meadow.patches());
   state.counters["patch_steps/s"] =
       benchmark::Counter(double(meadow.patches()) * double(state.iterations()), benchmark::Counter::kIsRate);

@@ -181,12 +181,6 @@ class FloorPass {
   StaggeredArrays arrays_;
 };
 
-/// The q-quantile (0..1) of v, by the nearest rank.
-double quantile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[std::min(v.size() - 1, size_t(q * double(v.size())))];
-}
-
 template <class T>
 void runFloor(benchmark::State& state, ScalarKind scalar) {
   const int64_t side = state.range(0);
@@ -212,15 +206,15 @@ void runFloor(benchmark::State& state, ScalarKind scalar) {
   }
   const double w = double(sizeof(T)), n = double(c.particles()), m = double(c.patches());
   const double bytes = n * (18 * w) + n * 3 * w + m * (4 * w + 2);
-  const double tick = quantile(tickMs, 0.5), floorTime = quantile(floorMs, 0.5);
+  const double tick = sg::bench::quantile(tickMs, 0.5), floorTime = sg::bench::quantile(floorMs, 0.5);
   // The spread: the ratio of each iteration's tick to the floor pass right after it.
   std::vector<double> ratios;
   for (size_t i = 0; i < tickMs.size(); ++i) ratios.push_back(tickMs[i] / floorMs[i]);
   state.counters["tick_ms"] = tick;
   state.counters["floor_ms"] = floorTime;
-  state.counters["ratio_to_floor"] = quantile(ratios, 0.5);
-  state.counters["ratio_p25"] = quantile(ratios, 0.25);
-  state.counters["ratio_p75"] = quantile(ratios, 0.75);
+  state.counters["ratio_to_floor"] = sg::bench::quantile(ratios, 0.5);
+  state.counters["ratio_p25"] = sg::bench::quantile(ratios, 0.25);
+  state.counters["ratio_p75"] = sg::bench::quantile(ratios, 0.75);
   state.counters["bytes_per_tick"] = bytes;
   state.counters["floor_GB/s"] = bytes / (floorTime / 1e3) / 1e9;
   state.counters["patches"] = m;

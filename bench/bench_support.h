@@ -2,6 +2,7 @@
 // never reads a clock) and the three bodies the collision benchmarks roll through the meadow.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <vector>
@@ -22,6 +23,12 @@ class StageTimer final : public StageObserver {
  private:
   std::chrono::steady_clock::time_point start_;
 };
+
+/// The q-quantile (0..1) of v, by the nearest rank (0 for no values).
+inline double quantile(std::vector<double> v, double q) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[std::min(v.size() - 1, size_t(q * double(v.size())))];
+}
 
 /// The thesis meadow (tufts 0.1 m apart, the built-in scenario's wind) at side x side patches.
 inline Scenario plainMeadow(int64_t side, int k, ScalarKind scalar) {
