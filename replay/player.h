@@ -19,8 +19,11 @@ Scenario recordedScenario(const sgr::Recording& recording, const VariantSettings
 
 struct VerifyReport {
   bool ok = true;
-  int64_t ticks = 0;           ///< ticks replayed
-  int64_t checksVerified = 0;  ///< CHCK/SNAP/END hashes that matched
+  int64_t ticks = 0;  ///< ticks replayed
+  /// Ticks whose recorded hashes (the header's initial hash, CHCK, SNAP, END) matched, each tick
+  /// once: a complete verify of a recording with the same settings reaches
+  /// Recording::hashedTicks().
+  int64_t checksVerified = 0;
   int64_t firstMismatchTick = -1;
   uint64_t expectedHash = 0, actualHash = 0;
   std::optional<SimError> fault;  ///< the replay faulted where the recording did not (or vice versa)

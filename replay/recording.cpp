@@ -104,6 +104,7 @@ RecordingInfo readRecordingInfo(const std::string& path) {
   info.inputs = int64_t(rec.inputs.size());
   info.checks = int64_t(rec.checks.size());
   info.snapshots = int64_t(rec.snapshots.size());
+  info.hashedTicks = rec.hashedTicks();
   info.complete = rec.end.has_value();
   if (rec.end && rec.end->faulted) info.fault = rec.end->message;
   if (rec.end && !rec.end->faulted) info.finalHash = rec.end->hash;

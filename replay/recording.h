@@ -91,6 +91,7 @@ struct RecordingInfo {
   int64_t startTick = 0, lastTick = 0;
   uint32_t checkEvery = 0, snapshotEvery = 0;
   int64_t inputs = 0, checks = 0, snapshots = 0;  ///< chunks of each kind
+  int64_t hashedTicks = 0;                        ///< ticks with a recorded hash (start, CHCK, SNAP, END), each once
   bool complete = false;                          ///< ends with END
   std::optional<uint64_t> finalHash;              ///< END's state hash, when it ended without a fault
   std::string fault;                              ///< the fault the recording stopped on; empty when none
@@ -106,7 +107,7 @@ RecordingInfo readRecordingInfo(const std::string& path);
 struct VerifyResult {
   bool ok = true;             ///< every recorded hash matched (and a recorded fault recurred)
   int64_t ticks = 0;          ///< ticks replayed
-  int64_t hashesChecked = 0;  ///< CHCK/SNAP/END hashes that matched
+  int64_t hashesChecked = 0;  ///< hashed ticks that matched (RecordingInfo::hashedTicks when all did)
   int64_t firstMismatchTick = -1;
   uint64_t expectedHash = 0, actualHash = 0;  ///< at firstMismatchTick, for a hash mismatch
   std::string error;                          ///< the replay faulted where the recording did not

@@ -79,11 +79,12 @@ struct CliResult {
 
 /// Runs `simgrass <args>` (args already shell-quoted where needed) with stdout and stderr
 /// captured separately, under a 60 s timeout so a hang is a failure rather than a stuck suite.
-inline CliResult runCli(const std::string& args) {
+/// `cwd`: the folder it runs in (default: the test's own).
+inline CliResult runCli(const std::string& args, const std::string& cwd = "") {
   TempDir dir;
   const std::string out = dir.file("stdout"), err = dir.file("stderr");
-  const std::string cmd =
-      "timeout -k 5 60 " + quote(SIMGRASS_CLI) + " " + args + " </dev/null >" + quote(out) + " 2>" + quote(err);
+  const std::string cmd = (cwd.empty() ? std::string() : "cd " + quote(cwd) + " && ") + "timeout -k 5 60 " +
+                          quote(SIMGRASS_CLI) + " " + args + " </dev/null >" + quote(out) + " 2>" + quote(err);
   const int status = std::system(cmd.c_str());
   CliResult r;
   if (status == -1) {

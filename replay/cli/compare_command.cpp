@@ -49,7 +49,7 @@ struct Row {
 /// The reference (the recording under its own settings) verified against the recorded hashes.
 struct Reference {
   std::vector<double> msPerTick;
-  int64_t verifiedTo = 0;  ///< last tick checked against the recording
+  int64_t verifiedTo = -1;  ///< last tick checked against the recording (-1: none yet)
   int64_t hashesChecked = 0, firstMismatchTick = -1;
   uint64_t expectedHash = 0, actualHash = 0;
 };
@@ -135,6 +135,15 @@ int compare(const CompareOptions& o) {
     }
     SimWorld& rw = refRun->world();
     SimWorld& vw = varRun->world();
+    if (v == 0 && ref.verifiedTo < 0) {  // the start state counts as a hashed tick, as in replay and diff
+      ref.verifiedTo = rw.tick();
+      if (const std::optional<uint64_t> expected = recordedHashes.at(rw.tick())) {
+        if (rw.stateHash() == *expected)
+          ++ref.hashesChecked;
+        else
+          ref.firstMismatchTick = rw.tick(), ref.expectedHash = *expected, ref.actualHash = rw.stateHash();
+      }
+    }
     const int64_t m = row.recordedTicksPerStep;
     for (int64_t k = 0; k * m <= ticks; ++k) {
       const int64_t target = k * m;
@@ -198,7 +207,7 @@ int compare(const CompareOptions& o) {
   const double refMs = medianOf(ref.msPerTick);
   const std::string refVerified =
       ref.firstMismatchTick >= 0 ? "DIFFERS from the recording from tick " + std::to_string(ref.firstMismatchTick)
-      : ref.hashesChecked > 0    ? "verified (" + std::to_string(ref.hashesChecked) + " recorded hashes match)"
+      : ref.hashesChecked > 0    ? "verified (" + std::to_string(ref.hashesChecked) + " hashed ticks match)"
                                  : "not verified (no recorded hashes in range)";
 
   const std::string csvHeader =

@@ -67,7 +67,7 @@ struct Side {
     if (fault) return "the replay FAULTED: " + fault->message();
     if (firstMismatchTick >= 0)
       return "the replay DIFFERS from the recording from tick " + std::to_string(firstMismatchTick);
-    return hashesChecked > 0 ? "replay verified (" + std::to_string(hashesChecked) + " hashes match)"
+    return hashesChecked > 0 ? "replay verified (" + std::to_string(hashesChecked) + " hashed ticks match)"
                              : "no recorded hashes to verify";
   }
 };

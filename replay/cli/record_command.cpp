@@ -21,6 +21,8 @@ struct RecordOptions {
   std::string scenario, output, inputTrack;
   int64_t ticks = -1;
   std::vector<std::string> variants;
+  /// `run`'s flags (--scalar fx16, --lod off, ...): each one a --variant key=value.
+  std::vector<std::pair<const char*, std::string>> shorthands;
   int threads = 1;
   int64_t checkEvery = -1, snapshotEvery = 300;
   int zstdLevel = 3;
@@ -39,6 +41,22 @@ std::pair<size_t, int64_t> busiestTick(const std::vector<ScriptedCommand>& comma
   return most;
 }
 
+/// The names of the settings both `a` and `b` set (a flag and a --variant of the same key).
+std::string sharedKeys(const VariantSettings& a, const VariantSettings& b) {
+  std::string keys;
+  auto both = [&](bool x, bool y, const char* key) {
+    if (x && y) keys += std::string(keys.empty() ? "" : ", ") + key;
+  };
+  both(a.scalar.has_value(), b.scalar.has_value(), "scalar");
+  both(a.interpolation.has_value(), b.interpolation.has_value(), "interp");
+  both(a.broadphase.has_value(), b.broadphase.has_value(), "broadphase");
+  both(a.bodyBroadphase.has_value(), b.bodyBroadphase.has_value(), "body-broadphase");
+  both(a.timeStep.has_value(), b.timeStep.has_value(), "dt");
+  both(a.lod.has_value(), b.lod.has_value(), "lod");
+  both(a.model.has_value(), b.model.has_value(), "model");
+  return keys;
+}
+
 int record(const RecordOptions& o) {
   // The recording must not replace the scenario or the input track it is made from (the
   // heightmap is checked once the scenario names it).
@@ -50,6 +68,12 @@ int record(const RecordOptions& o) {
   try {
     VariantSettings variant;
     for (const std::string& v : o.variants) variant = VariantSettings::parse(v).over(variant);
+    VariantSettings flags;
+    for (const auto& [key, value] : o.shorthands)
+      if (!value.empty()) flags = VariantSettings::parse(std::string(key) + "=" + value).over(flags);
+    if (const std::string keys = sharedKeys(flags, variant); !keys.empty())
+      throw std::invalid_argument(keys + ": expected each setting once, as a flag or as a --variant, got both");
+    variant = variant.over(flags);
     scenario = loadScenarioFile(o.scenario, &files);
     variant.applyTo(scenario);
     if (!o.inputTrack.empty()) {
@@ -171,6 +195,22 @@ void addRecordCommand(CLI::App& app, int* exitCode) {
                   "Settings over the scenario: scalar=fx16, interp=2, broadphase=brute, "
                   "body-broadphase=sap, dt=1/120, lod=off, model=blade (repeatable)")
       ->allow_extra_args(false);  // one value per --variant: a scenario path after it stays the scenario
+  // The same flags as `simgrass run`, each a shorthand for --variant KEY=VALUE.
+  o->shorthands = {{"scalar", ""}, {"interp", ""}, {"broadphase", ""}, {"body-broadphase", ""},
+                   {"lod", ""},    {"dt", ""},     {"model", ""}};
+  cmd->add_option("--scalar", o->shorthands[0].second, "Scalar type (= --variant scalar=...)")
+      ->check(CLI::IsMember({"fx32", "fx16", "float", "double"}));
+  cmd->add_option("--interp", o->shorthands[1].second, "Interpolation k, 1..4 (= --variant interp=...)");
+  cmd->add_option("--broadphase", o->shorthands[2].second, "Particle-vs-body broad phase (= --variant broadphase=...)")
+      ->check(CLI::IsMember({"grid", "brute"}));
+  cmd->add_option("--body-broadphase", o->shorthands[3].second,
+                  "Body-vs-body broad phase (= --variant body-broadphase=...)")
+      ->check(CLI::IsMember({"brute", "sap"}));
+  cmd->add_option("--lod", o->shorthands[4].second, "Level of detail: off or window (= --variant lod=...)")
+      ->check(CLI::IsMember({"off", "window"}));
+  cmd->add_option("--dt", o->shorthands[5].second, "Time step in s, e.g. 1/120 (= --variant dt=...)");
+  cmd->add_option("--model", o->shorthands[6].second, "Grass model: thesis, pbd or blade (= --variant model=...)")
+      ->check(CLI::IsMember({"thesis", "pbd", "blade"}));
   cmd->add_option("--threads", o->threads, "Worker threads (the recording is identical for any count)")
       ->check(CLI::Range(1, 256));
   cmd->add_option("--check-every", o->checkEvery, "Ticks between state hashes (default: 1 up to ~130,000 patches)")

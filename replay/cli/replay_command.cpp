@@ -44,7 +44,8 @@ nlohmann::json headerJson(const sgr::Recording& r) {
           {"complete", r.end.has_value()},
           {"inputs", r.inputs.size()},
           {"checks", r.checks.size()},
-          {"snapshots", r.snapshots.size()}};
+          {"snapshots", r.snapshots.size()},
+          {"hashedTicks", r.hashedTicks()}};
 }
 
 int replay(const ReplayOptions& o) {
@@ -70,10 +71,12 @@ int replay(const ReplayOptions& o) {
       std::printf("scenario   %s, %s\n", escapeControl(rec->header.scenarioSource).c_str(),
                   escapeControl(rec->header.variant).c_str());
       std::printf("built by   %s\n", escapeControl(rec->header.buildId).c_str());
-      std::printf("ticks      %" PRId64 " to %" PRId64 "; %zu input chunk%s, %zu hash%s, %zu snapshot%s\n",
+      std::printf("ticks      %" PRId64 " to %" PRId64 "; %zu input chunk%s, %zu check%s, %zu snapshot%s\n",
                   rec->header.startTick, rec->lastTick(), rec->inputs.size(), rec->inputs.size() == 1 ? "" : "s",
-                  rec->checks.size(), rec->checks.size() == 1 ? "" : "es", rec->snapshots.size(),
+                  rec->checks.size(), rec->checks.size() == 1 ? "" : "s", rec->snapshots.size(),
                   rec->snapshots.size() == 1 ? "" : "s");
+      std::printf("hashed     %" PRId64 " ticks (the start, checks, snapshots and the end, each tick once)\n",
+                  rec->hashedTicks());
     }
     return rec->truncated ? kExitTruncated : kExitOk;
   }
@@ -124,7 +127,8 @@ int replay(const ReplayOptions& o) {
         }
         code = kExitMismatch;
       } else if (!o.json) {
-        std::printf("verified %" PRId64 " ticks (%" PRId64 " hashes match)\n", v.ticks, v.checksVerified);
+        std::printf("verified %" PRId64 " ticks (%" PRId64 " of %" PRId64 " hashed ticks match, the start included)\n",
+                    v.ticks, v.checksVerified, rec->hashedTicks());
       }
       inFaultedStep = v.ok && rec->end && rec->end->faulted;
     }

@@ -87,6 +87,8 @@ int runScenario(const RunOptions& o) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const int64_t ran = world->tick();
   const uint64_t finalHash = world->stateHash();
+  // Contacts and the window's place are the last tick's: read after the loop, not with `counts`.
+  const WorldCounts last = world->counts();
   const double msPerTick = ran > 0 ? seconds * 1e3 / double(ran) : 0.0;
   const double patchSteps = ran > 0 ? double(counts.patches()) * double(ran) / seconds : 0.0;
 
@@ -111,18 +113,19 @@ int runScenario(const RunOptions& o) {
     j["counts"] = {{"patchesX", counts.patchesX},     {"patchesZ", counts.patchesZ},
                    {"patches", counts.patches()},     {"particlesX", counts.particlesX},
                    {"particlesZ", counts.particlesZ}, {"particles", counts.particles()},
-                   {"bodies", counts.bodies},         {"contacts", counts.contacts}};
+                   {"bodies", counts.bodies},         {"contacts", last.contacts}};
     if (counts.lodWindow)
-      j["lod"] = {{"windowPatchesX", counts.windowPatchesX},
-                  {"windowPatchesZ", counts.windowPatchesZ},
-                  {"originI", counts.windowOriginI},
-                  {"originJ", counts.windowOriginJ}};
+      j["lod"] = {{"windowPatchesX", last.windowPatchesX},
+                  {"windowPatchesZ", last.windowPatchesZ},
+                  {"originI", last.windowOriginI},
+                  {"originJ", last.windowOriginJ}};
     j["ticks"] = ran;
     j["finalHash"] = hex(finalHash);
     if (o.hashEvery > 0) j["hashes"] = hashes;
     nlohmann::json stages = nlohmann::json::object();
     for (size_t s = 0; s < size_t(Stage::Count); ++s)
-      stages[stageName(Stage(s))] = ran > 0 ? double(clock.nanos[s]) / 1e6 / double(ran) : 0.0;
+      if (stageIsTimed(Stage(s)))
+        stages[timedStageName(Stage(s))] = ran > 0 ? double(clock.nanos[s]) / 1e6 / double(ran) : 0.0;
     j["timing"] = {{"seconds", seconds},
                    {"msPerTick", msPerTick},
                    {"patchStepsPerSecond", patchSteps},
@@ -140,13 +143,13 @@ int runScenario(const RunOptions& o) {
         "patches    %" PRId64 " (%" PRId64 " x %" PRId64 "), particles %" PRId64 " (%" PRId64 " x %" PRId64 ")\n",
         counts.patches(), counts.patchesX, counts.patchesZ, counts.particles(), counts.particlesX, counts.particlesZ);
     if (counts.lodWindow) {
-      const WorldCounts now = world->counts();
+      const WorldCounts& now = last;
       std::printf("lod        window of %" PRId64 " x %" PRId64 " patches, at patch (%" PRId64 ", %" PRId64
                   ") after the last tick\n",
                   now.windowPatchesX, now.windowPatchesZ, now.windowOriginI, now.windowOriginJ);
     }
     if (counts.bodies > 0)
-      std::printf("bodies     %" PRId64 ", %" PRId64 " contacts in the last tick\n", counts.bodies, counts.contacts);
+      std::printf("bodies     %" PRId64 ", %" PRId64 " contacts in the last tick\n", counts.bodies, last.contacts);
     std::printf("ticks      %" PRId64 " (%.3f s simulated at dt = %s s)\n", ran,
                 double(ran) * scenario.timeStep.toDouble(), scenario.timeStep.toString().c_str());
     std::printf("hash       %s (state after tick %" PRId64 ")\n", hex(finalHash).c_str(), ran);
@@ -154,7 +157,8 @@ int runScenario(const RunOptions& o) {
                 patchSteps / 1e6);
     std::printf("stages     ");
     for (size_t s = 0; s < size_t(Stage::Count); ++s)
-      std::printf("%s %.3f  ", stageName(Stage(s)), ran > 0 ? double(clock.nanos[s]) / 1e6 / double(ran) : 0.0);
+      if (stageIsTimed(Stage(s)))
+        std::printf("%s %.3f  ", timedStageName(Stage(s)), ran > 0 ? double(clock.nanos[s]) / 1e6 / double(ran) : 0.0);
     std::printf("(ms/tick)\n");
   }
   if (!failure.ok) {

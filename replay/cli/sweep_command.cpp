@@ -37,7 +37,7 @@ namespace fs = std::filesystem;
 constexpr const char* kDefaultScenarios = "scenarios/sweep-bodies.json,scenarios/sweep-mower.json";
 
 struct SweepOptions {
-  std::string scenarios = kDefaultScenarios, out = "docs/results";
+  std::string scenarios = kDefaultScenarios, out = "sweep-results";  // never the committed docs/results by default
   std::string scalars = "fx16,fx32,float,double", ks = "1,2,3,4", dts = "1/30,1/60,1/120,1/240", lods = "off,window";
   std::string broadphases = "grid";
   std::string models;  ///< empty: each scenario's own grass model

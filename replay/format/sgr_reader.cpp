@@ -472,6 +472,17 @@ bool hasRecordingMagic(const std::string& path) {
          in.readAt(0, magic, &expected) && std::memcmp(magic, kMagic, sizeof magic) == 0;
 }
 
+int64_t Recording::hashedTicks() const {
+  std::vector<int64_t> ticks;
+  ticks.reserve(checks.size() + snapshots.size() + 2);
+  ticks.push_back(header.startTick);
+  for (const Check& c : checks) ticks.push_back(c.tick);
+  for (const SnapshotInfo& s : snapshots) ticks.push_back(s.tick);
+  if (end && !end->faulted) ticks.push_back(end->tick);
+  std::sort(ticks.begin(), ticks.end());
+  return int64_t(std::unique(ticks.begin(), ticks.end()) - ticks.begin());
+}
+
 int64_t Recording::lastTick() const {
   if (end) return end->tick;
   int64_t t = header.startTick;

@@ -27,6 +27,10 @@ struct Recording {
   uint64_t truncatedAt = 0;
   std::string truncatedExpected;
 
+  /// The ticks whose state the recording names by a hash: the start tick (the header's initial
+  /// hash), every CHCK, SNAP and a clean END, each tick counted once. What `replay --info`,
+  /// `replay --verify` and the viewer's playback panel all count as "hashed ticks".
+  int64_t hashedTicks() const;
   /// Last tick the recording covers: END's tick, else the last tick any chunk names.
   int64_t lastTick() const;
   /// The input for the step from `tick` to `tick + 1` (camera carried, commands of that tick).

@@ -43,6 +43,14 @@ inline const char* stageName(Stage s) {
   return "?";
 }
 
+/// Whether a StageObserver sees the stage begin and end. The rod projection runs fused with the
+/// integration, row by row (sim/particles/particle_row.h), so Constraints is never timed on its
+/// own: timing tables leave it out rather than show a zero.
+inline bool stageIsTimed(Stage s) { return s != Stage::Constraints && s != Stage::Count; }
+
+/// The name a timing table gives a timed stage: Integrate's time includes the rod projection.
+inline const char* timedStageName(Stage s) { return s == Stage::Integrate ? "integrate+constraints" : stageName(s); }
+
 /// Receives stage boundaries; implemented by tools that measure time (replay/).
 class StageObserver {
  public:

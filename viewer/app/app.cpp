@@ -410,7 +410,7 @@ int App::run(const std::vector<ScriptCommand>* script, const std::string& startu
   }
   errorText_ = startupError;
   extractScene(world(), scenario(), &scene_);
-  cam_.camera = defaultCamera(scene_, world());
+  cam_.camera = defaultCamera(scene_, world(), float(opt_.width) / float(opt_.height));
   cam_.eyeHeight = cam_.camera.y - groundHeight(world(), cam_.camera.x, cam_.camera.z);
   render_.alphaToCoverage = samples_ > 0;
   if (play_) play_->playing = !scripted_;  // interactive: starts playing; scripts start paused

@@ -41,7 +41,7 @@ bool App::openFile(const std::string& path) {
   stagedJson_.reset();  // `set` edits staged for the previous scenario
   resetEdits();
   extractScene(world(), scenario(), &scene_);
-  cam_.camera = defaultCamera(scene_, world());
+  cam_.camera = defaultCamera(scene_, world(), float(opt_.width) / float(opt_.height));
   cam_.eyeHeight = cam_.camera.y - groundHeight(world(), cam_.camera.x, cam_.camera.z);
   return true;
 }

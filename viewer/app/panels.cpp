@@ -45,7 +45,7 @@ void App::panelStats() {
   if (!play_) {
     ImGui::Text("simulation %.2f ms/tick", simMsPerTick_);
     for (size_t st = 0; st < size_t(Stage::Count); ++st)
-      ImGui::Text("  %-12s %.3f ms", stageName(Stage(st)), stageMs_[st]);
+      if (stageIsTimed(Stage(st))) ImGui::Text("  %-22s %.3f ms", timedStageName(Stage(st)), stageMs_[st]);
   }
   ImGui::Text("hash %s", hex(world().stateHash()).c_str());
 }

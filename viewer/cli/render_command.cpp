@@ -268,7 +268,7 @@ int render(const RenderOptions& o) {
   int width = 0, height = 0;
   if (!parseSize(o.size, &width, &height))
     return fail(kExitBadInput, "--size: expected WxH with both from 16 to 8192, got '" + shown(o.size) + "'");
-  std::optional<viewer::Camera> fixedCamera;
+  std::optional<viewer::Camera> fixedCamera, framed;  // --camera; the default view, framed once
   if (!o.camera.empty()) {
     fixedCamera = parseCamera(o.camera);
     if (!fixedCamera)
@@ -424,8 +424,11 @@ int render(const RenderOptions& o) {
         camera = *fixedCamera;
       else if (input.hasCamera)
         camera = trackCamera(input, inputAt(tick + 30), scene, world);
-      else
-        camera = viewer::defaultCamera(scene, world);
+      else {
+        // Framed once, at the first frame rendered: the frames of a sheet share one view.
+        if (!framed) framed = viewer::defaultCamera(scene, world, float(width) / float(height));
+        camera = *framed;
+      }
       double frameMs = 0;
       const viewer::Image image = renderer->render(scene, camera, &frameMs);
       renderMs.push_back(frameMs);
@@ -524,8 +527,9 @@ void addRenderCommand(CLI::App& app, int* exitCode) {
   cmd->add_option("--size", o->size, "Frame size WxH (default 800x600)");
   cmd->add_option("--camera", o->camera,
                   "x,y,z,yaw,pitch: a fixed camera (m, degrees; yaw 0 looks along +z, 90 along +x). Default: the "
-                  "input's camera track if any, else 1.7 m above the ground at the -z edge of the simulated grass, "
-                  "looking at its centre");
+                  "input's camera track if any, else a view framing the bodies at the first frame rendered (25 degrees "
+                  "above, from -z), else 1.7 m above the ground at the -z edge of the simulated grass, looking at its "
+                  "centre");
   cmd->add_option("--msaa", o->msaa, "Samples per pixel: 0 (alpha test) or 2/4/8 (alpha to coverage; default 4)");
   cmd->add_flag("--ssao", o->ssao,
                 "Screen-space ambient occlusion (depth prepass where the tufts' alpha passes, half resolution)");

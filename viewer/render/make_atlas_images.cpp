@@ -3,7 +3,9 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <string>
+#include <system_error>
 
 #include "viewer/render/atlas.h"
 
@@ -13,7 +15,7 @@ int main(int argc, char** argv) {
   std::string outDir;
   int variants = 4;
   uint64_t seed = 1;
-  app.add_option("OUTDIR", outDir, "Existing directory to write the PNGs into")->required();
+  app.add_option("OUTDIR", outDir, "Directory to write the PNGs into (created if missing)")->required();
   app.add_option("--variants", variants, "Grass tuft variants (atlas columns, plus the marking tuft)")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
@@ -27,6 +29,15 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  {
+    std::error_code ec;
+    std::filesystem::create_directories(outDir, ec);  // fails on a file of that name: said below
+    if (ec || !std::filesystem::is_directory(outDir, ec)) {
+      std::fprintf(stderr, "simgrass-atlas: %s: expected a folder that exists or can be created%s%s\n", outDir.c_str(),
+                   ec ? ": " : "", ec ? ec.message().c_str() : "");
+      return 2;
+    }
+  }
   const auto start = std::chrono::steady_clock::now();
   const sg::viewer::TuftAtlas atlas = sg::viewer::makeTuftAtlas(variants, seed);
   const auto atlasDone = std::chrono::steady_clock::now();

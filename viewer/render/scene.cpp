@@ -528,7 +528,51 @@ float groundHeight(const SimWorld& world, float x, float z) {
   });
 }
 
-Camera defaultCamera(const Scene& scene, const SimWorld& world) {
+Camera defaultCamera(const Scene& scene, const SimWorld& world, float aspect) {
+  if (!scene.bodyParts.empty()) {
+    // The bodies' bounds: each part's centre plus its largest scale (a radius or half extent; a
+    // mesh's model holds no scale, so its size is not known here: 0.5 m).
+    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+    for (const BodyPartDraw& p : scene.bodyParts) {
+      float extent = 0.5f;
+      if (p.shape != BodyPartDraw::Shape::Mesh)
+        for (size_t c = 0; c < 3; ++c) {
+          const float* col = &p.model[c * 4];
+          extent = std::max(extent, std::sqrt(col[0] * col[0] + col[1] * col[1] + col[2] * col[2]));
+        }
+      for (size_t a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], p.model[12 + a] - extent);
+        hi[a] = std::max(hi[a], p.model[12 + a] + extent);
+      }
+    }
+    for (size_t a = 0; a < 3; ++a) {  // at least 3 m across: a lone ball is seen with grass around it
+      const float grow = std::max(0.0f, 1.5f - 0.5f * (hi[a] - lo[a]));
+      lo[a] -= grow;
+      hi[a] += grow;
+    }
+    const float tx = 0.5f * (lo[0] + hi[0]), ty = 0.5f * (lo[1] + hi[1]), tz = 0.5f * (lo[2] + hi[2]);
+    const float elevation = 20 * Camera::kRadians;
+    auto at = [&](float distance) {
+      const float ex = tx, ez = tz - distance * std::cos(elevation);
+      const float ey = std::max(ty + distance * std::sin(elevation), groundHeight(world, ex, ez) + 1.7f);
+      return Camera::lookingAt(ex, ey, ez, tx, ty, tz);
+    };
+    auto fits = [&](const Camera& c) {
+      const Mat4 m = multiply(c.projection(aspect), c.view());
+      for (int corner = 0; corner < 8; ++corner) {
+        const float p[3] = {corner & 1 ? hi[0] : lo[0], corner & 2 ? hi[1] : lo[1], corner & 4 ? hi[2] : lo[2]};
+        float clip[4];
+        for (size_t r = 0; r < 4; ++r) clip[r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
+        if (clip[3] <= c.nearPlane || std::fabs(clip[0]) > 0.8f * clip[3] || std::fabs(clip[1]) > 0.8f * clip[3])
+          return false;
+      }
+      return true;
+    };
+    // The nearest distance that fits, in 5 % steps (bounds of any size: at most ~330 steps to 10 km).
+    float distance = 1;
+    while (distance < 1e4f && !fits(at(distance))) distance *= 1.05f;
+    return at(distance);
+  }
   const float cx = 0.5f * (scene.focusMinX + scene.focusMaxX), cz = 0.5f * (scene.focusMinZ + scene.focusMaxZ);
   const float ez = scene.focusMinZ - 1.0f;
   const float eyeY = groundHeight(world, cx, ez) + 1.7f;

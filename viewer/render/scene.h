@@ -124,8 +124,11 @@ void applyDivergenceHeat(const Observation& a, const Observation& b, float fullS
 /// Terrain height (m) at (x, z) of the world, for camera placement.
 float groundHeight(const SimWorld& world, float x, float z);
 
-/// The default view of a scene: 1.7 m above the ground just outside the -z edge of the simulated
-/// grass, looking at its centre.
-Camera defaultCamera(const Scene& scene, const SimWorld& world);
+/// The default view of a scene, for a frame of width/height `aspect`. With bodies: the nearest
+/// view from the -z side, 20 degrees above, that keeps every corner of the bodies' bounds (grown
+/// to at least 3 m across) inside the middle 80 % of the frame, the eye at least 1.7 m above the
+/// ground. Without: 1.7 m above the ground just outside the -z edge of the simulated grass,
+/// looking at its centre.
+Camera defaultCamera(const Scene& scene, const SimWorld& world, float aspect = 16.0f / 9.0f);
 
 }  // namespace sg::viewer
