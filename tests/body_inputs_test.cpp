@@ -512,5 +512,107 @@ TEST(BodyInputs, RecordingWithBodyInputsVerifiesAndSeeksPastTheSpawn) {
   }
 }
 
+// ---- DragTo: the viewer's mouse drag -------------------------------------------------------------
+
+/// A 0.2 m ball resting on a small meadow (a sphere's drag has no lever arm to tumble it).
+Scenario restingBall() {
+  return parseScenario(R"({"format": "simgrass-scenario/1", "name": "drag",
+      "field": {"patchesX": 21, "patchesZ": 21, "spacing": 0.25}, "wind": {"schedule": []},
+      "bodies": {"list": [{"name": "ball", "position": [0, 0.2, 0], "shape": {"type": "sphere", "radius": 0.2}}]}})",
+                       "drag.json", {});
+}
+
+template <class S>
+double toMetres(S v) {
+  return double(v);
+}
+template <>
+double toMetres(Fx32 v) {
+  return v.toDouble();
+}
+template <>
+double toMetres(Fx16 v) {
+  return v.toDouble();
+}
+
+template <class S>
+void dragSettlesOnTheTarget() {
+  // Box2D's mouse joint, 5 Hz and damping ratio 0.7, applied at the start of each tick: the centre
+  // of mass reaches the target and hangs below it, the spring holding the weight. In steady state
+  // the tick's pull dv = m_s (-v_end - b C) must return the g h that gravity took, while the mean
+  // velocity over the tick is zero (v_end = -g h / 2): C = g h (1/2 - 1/m_s) / b, with m_s and b
+  // the implicit coefficients (h omega = 0.52: m_s = 0.502, b = 16.3 /s), 15 mm (9.9 mm, g /
+  // omega^2, in the continuous limit). The decay's time constant is ~1 / (zeta omega) = 45 ms:
+  // after 1.5 s it hangs there within 3 mm (sub-steps integrate the fall inside the tick) and no
+  // longer moves (under 0.1 mm over a further 10 ticks).
+  auto w = makeTyped<S>(restingBall());
+  const InputVec3 target = at(3, 5, -2, 2);  // (1.5, 2.5, -1) m
+  stepN(*w, 90, command(0, BodyCommandKind::DragTo, target));
+  const double h = 1.0 / 60, omega = 2 * 3.14159265358979 * 5, zeta = 0.7;
+  const double a1 = 2 * zeta + h * omega, a2 = h * omega * a1, massScale = a2 / (1 + a2), bias = omega / a1;
+  const double sag = 9.81 * h * (1 / massScale - 0.5) / bias;
+  ASSERT_NEAR(sag, 0.015, 1e-3);
+  const Vec3<S> before = w->bodies()[0].position;
+  stepN(*w, 10, command(0, BodyCommandKind::DragTo, target));
+  const RigidBody<S>& b = w->bodies()[0];
+  EXPECT_NEAR(toMetres(b.position.x()), 1.5, 2e-3);
+  EXPECT_NEAR(toMetres(b.position.y()), 2.5 - sag, 3e-3);
+  EXPECT_NEAR(toMetres(b.position.z()), -1.0, 2e-3);
+  for (int a = 0; a < 3; ++a)
+    EXPECT_LT(std::fabs(toMetres(S(b.position[a] - before[a]))), 1e-4) << "still moving along axis " << a;
+  // Let go: it falls back to the ground and comes to rest there.
+  stepN(*w, 240);
+  EXPECT_NEAR(toMetres(w->bodies()[0].position.y()), 0.2, 0.01);
+}
+
+TEST(BodyInputs, DragToSettlesOnTheTargetFx32) { dragSettlesOnTheTarget<Fx32>(); }
+TEST(BodyInputs, DragToSettlesOnTheTargetFx16) { dragSettlesOnTheTarget<Fx16>(); }
+TEST(BodyInputs, DragToSettlesOnTheTargetDouble) { dragSettlesOnTheTarget<double>(); }
+
+TEST(BodyInputs, DragToAFarTargetIsBounded) {
+  // A target a million metres away (a hostile or mistaken input) pulls at most 50 m/s per axis
+  // a tick (settings::kDragMaxSpeedChange): bounded, no fault. fx16 holds 32,767 m: 30 km away.
+  const InputVec3 far = at(1000000, -1000000, 1000000);
+  auto fx16 = makeTyped<Fx16>(restingBall());
+  ASSERT_TRUE(fx16->step(command(0, BodyCommandKind::DragTo, at(30000, -30000, 30000))).ok);
+  EXPECT_LE(fx16->bodies()[0].velocity.x().toDouble(), 50.0 + 1e-4);
+  auto fx32 = makeTyped<Fx32>(restingBall());
+  ASSERT_TRUE(fx32->step(command(0, BodyCommandKind::DragTo, far)).ok);
+  const double vx = fx32->bodies()[0].velocity.x().toDouble();
+  EXPECT_GT(vx, 1.0);
+  EXPECT_LE(vx, 50.0 + 1e-6);
+  auto d = makeTyped<double>(restingBall());
+  for (int t = 0; t < 3; ++t) ASSERT_TRUE(d->step(command(0, BodyCommandKind::DragTo, far)).ok);
+  EXPECT_LE(d->bodies()[0].velocity.x(), 3 * 50.0 + 1e-9);
+}
+
+TEST(BodyInputs, DragToIsARecordedInputThatReplaysBitForBit) {
+  // The viewer records one DragTo a tick while the mouse button is held: the drag is an input like
+  // any other, so a recording of it verifies, and the script and track name it "dragTo".
+  const Scenario s = restingBall();
+  std::unique_ptr<SimWorld> world = makeWorld(s, 1);
+  TempDir dir;
+  const std::string path = dir.file("drag.sgr");
+  {
+    Recorder recorder(path, s, {}, *world, RecordSettings{});
+    for (int64_t t = 0; t < 60; ++t) {
+      // The target moves along a circle's chord, as a mouse would (exact sixtieths of a metre).
+      const StepResult r = recorder.step(command(0, BodyCommandKind::DragTo, at(t, 30, 60 - t, 60)));
+      ASSERT_TRUE(r.ok) << r.error.message();
+    }
+    recorder.finish();
+  }
+  const sgr::Recording r = sgr::readRecording(path);
+  EXPECT_EQ(r.inputAt(7).bodies.at(0).kind, BodyCommandKind::DragTo);
+  Player player(r);
+  const VerifyReport v = player.verify();
+  EXPECT_TRUE(v.ok) << "first mismatch at tick " << v.firstMismatchTick;
+  const InputTrack track = parseInputTrack(R"({"format": "simgrass-input-track/1", "commands": [
+      {"tick": 1, "body": "ball", "command": "dragTo", "value": [1, 2, 3]}]})",
+                                           "track.json", s);
+  ASSERT_EQ(track.commands.size(), 1u);
+  EXPECT_EQ(track.commands[0].kind, BodyCommandKind::DragTo);
+}
+
 }  // namespace
 }  // namespace sg

@@ -267,9 +267,9 @@ void parseInput(Recording& r, Cursor& c, TickInput& camera, Ticks& ticks) {
     if (cmd.body < 0) c.fail(bodyAt, "a body index >= 0, got " + std::to_string(cmd.body));
     const uint64_t kindAt = c.offset();
     const uint8_t kind = c.get<uint8_t>("a command kind");
-    if (kind > uint8_t(BodyCommandKind::MowerOff))
+    if (kind > uint8_t(BodyCommandKind::DragTo))
       c.fail(kindAt,
-             "a command kind 0.." + std::to_string(int(BodyCommandKind::MowerOff)) + ", got " + std::to_string(kind));
+             "a command kind 0.." + std::to_string(int(BodyCommandKind::DragTo)) + ", got " + std::to_string(kind));
     cmd.kind = BodyCommandKind(kind);
     cmd.value = c.vec3("a command value");
     rec.input.bodies.push_back(cmd);

@@ -47,11 +47,27 @@ void World<S>::applyCommands(const TickInput& input) {
       case BodyCommandKind::Reset:
         resetBody(size_t(cmd.body));
         break;
+      case BodyCommandKind::DragTo:
+        applyDrag(b, v);
+        break;
       case BodyCommandKind::Spawn:
       case BodyCommandKind::MowerOn:
       case BodyCommandKind::MowerOff:
         break;  // handled above
     }
+  }
+}
+
+template <class S>
+void World<S>::applyDrag(RigidBody<S>& b, const Vec3<S>& target) {
+  // Box2D's mouse joint without its accumulated impulse (a fresh command every tick): the soft
+  // constraint C = p - target solved once over the tick, dv = massScale (-v - biasRate C). Per
+  // axis, the offset and the change are clamped (settings.h): bounded inputs, bounded products.
+  const Softness<S>& soft = dragSoftness_;
+  for (int a = 0; a < 3; ++a) {
+    const S offset = minS(maxS(S(b.position[a] - target[a]), S(-dragMaxOffset_)), dragMaxOffset_);
+    const S dv = soft.massScale * S(-b.velocity[a] - soft.biasRate * offset);
+    b.velocity[a] += minS(maxS(dv, S(-dragMaxDv_)), dragMaxDv_);
   }
 }
 
@@ -146,14 +162,15 @@ bool World<S>::bladeOn(int64_t body) const {
   return body >= 0 && body < int64_t(bodies_.size()) && bodies_[size_t(body)].mower && bodies_[size_t(body)].bladeOn;
 }
 
-#define SG_INSTANTIATE_COMMANDS(S)                              \
-  template void World<S>::applyCommands(const TickInput&);      \
-  template void World<S>::resetBody(size_t);                    \
-  template void World<S>::wakeBodiesNear(const Vec3<S>&, S);    \
-  template void World<S>::wakeIsland(int32_t);                  \
-  template void World<S>::spawnBody(int32_t, const InputVec3&); \
-  template void World<S>::dropCachedImpulses(size_t);           \
-  template int32_t World<S>::bodyTemplate(int64_t) const;       \
+#define SG_INSTANTIATE_COMMANDS(S)                                  \
+  template void World<S>::applyCommands(const TickInput&);          \
+  template void World<S>::applyDrag(RigidBody<S>&, const Vec3<S>&); \
+  template void World<S>::resetBody(size_t);                        \
+  template void World<S>::wakeBodiesNear(const Vec3<S>&, S);        \
+  template void World<S>::wakeIsland(int32_t);                      \
+  template void World<S>::spawnBody(int32_t, const InputVec3&);     \
+  template void World<S>::dropCachedImpulses(size_t);               \
+  template int32_t World<S>::bodyTemplate(int64_t) const;           \
   template bool World<S>::bladeOn(int64_t) const;
 
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE_COMMANDS)

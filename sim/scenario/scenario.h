@@ -85,6 +85,8 @@ enum class BodyCommandKind : uint8_t {
                 ///< with the template's initial orientation; at most kMaxBodies, else ignored
   MowerOn,      ///< a mower's blade cuts again (mowers start on); ignored for other bodies
   MowerOff,     ///< a mower's blade stops cutting (the body still collides); ignored for others
+  DragTo,       ///< a spring (settings::kDragHertz) pulls the centre of mass toward value (m) for
+                ///< this tick: the viewer's mouse drag, one command a tick while the button is held
 };
 /// Scenario bodies plus spawned ones never exceed this; a Spawn beyond it is ignored.
 inline constexpr int kMaxBodies = 64;

@@ -621,7 +621,8 @@ void parseScript(const Reader& r, const json& j, const Scenario& s, const std::s
                                           {"reset", BodyCommandKind::Reset},
                                           {"spawn", BodyCommandKind::Spawn},
                                           {"mowerOn", BodyCommandKind::MowerOn},
-                                          {"mowerOff", BodyCommandKind::MowerOff}});
+                                          {"mowerOff", BodyCommandKind::MowerOff},
+                                          {"dragTo", BodyCommandKind::DragTo}});
     // reset and the blade switches take no value; every other command needs one.
     const bool needsValue = cmd.kind != BodyCommandKind::Reset && cmd.kind != BodyCommandKind::MowerOn &&
                             cmd.kind != BodyCommandKind::MowerOff;

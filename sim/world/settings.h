@@ -39,6 +39,16 @@ inline constexpr Exact kLinearSlop{1, 200};
 /// needs; an exact fraction, so every scalar rounds it once).
 inline constexpr Exact kPi{355, 113};
 
+// ---- the viewer's mouse drag (BodyCommandKind::DragTo, sim/bodies/body_commands.cpp) --------
+/// Box2D's mouse joint: a soft spring of 5 Hz, damping ratio 0.7, on the centre of mass, solved
+/// implicitly over the tick (stable at any dt). It sags g / omega^2 = 1 cm under gravity.
+inline constexpr Exact kDragHertz{5, 1};
+inline constexpr Exact kDragDampingRatio{7, 10};
+/// The pull is bounded, so a target far away (a hostile input) neither overflows nor flings:
+/// the offset counts at most 10 m per axis, the velocity change at most 50 m/s per axis a tick.
+inline constexpr Exact kDragMaxOffset{10, 1};
+inline constexpr Exact kDragMaxSpeedChange{50, 1};
+
 // ---- sleep (sim/bodies/integrate_bodies.h) --------------------------------------------------
 /// A body below both speeds for kSleepTime falls asleep (m/s, rad/s, s).
 inline constexpr Exact kSleepLinearSpeed{1, 20};

@@ -33,8 +33,8 @@ void setCamera(const std::vector<CameraKey>& keys, int64_t tick, TickInput& inpu
 
 std::string describeInputCause(const Scenario& scenario, const InputTrack* track, int64_t tick, int32_t body) {
   if (body < 0) return "";
-  static constexpr const char* kCommandNames[] = {"displace", "addVelocity", "impulse", "teleport",
-                                                  "reset",    "spawn",       "mowerOn", "mowerOff"};
+  static constexpr const char* kCommandNames[] = {"displace", "addVelocity", "impulse",  "teleport", "reset",
+                                                  "spawn",    "mowerOn",     "mowerOff", "dragTo"};
   const std::vector<ScriptedCommand>& commands = track ? track->commands : scenario.script;
   const std::string& file = track ? track->sourceName : scenario.sourceName;
   const char* array = track ? "$.commands" : "$.script";

@@ -23,7 +23,8 @@ struct InputVec3 {
 struct BodyCommand {
   int32_t body = 0;
   BodyCommandKind kind = BodyCommandKind::AddVelocity;
-  InputVec3 value;  ///< m, m/s or N s depending on the kind (Spawn: m; ignored by Reset, MowerOn, MowerOff)
+  InputVec3 value;  ///< m, m/s or N s depending on the kind (Spawn, DragTo: m; ignored by Reset, MowerOn,
+                    ///< MowerOff)
   friend bool operator==(const BodyCommand&, const BodyCommand&) = default;
 };
 

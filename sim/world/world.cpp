@@ -158,6 +158,10 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   speculativeDistance_ = toS<S>(exact(settings::kSpeculativeDistance));
   bodyBroadphase_ = s.bodies.bodyBroadphase;
   grassDragDt_ = toS<S>(s.bodies.grassDrag) * particleConsts_.dt;
+  dragSoftness_ = makeSoftness(toS<S>(exact(settings::kDragHertz)), toS<S>(exact(settings::kDragDampingRatio)),
+                               particleConsts_.dt, toS<S>(exact(settings::kPi)));
+  dragMaxOffset_ = toS<S>(exact(settings::kDragMaxOffset));
+  dragMaxDv_ = toS<S>(exact(settings::kDragMaxSpeedChange));
   sleepLinear_ = toS<S>(exact(settings::kSleepLinearSpeed));
   sleepAngular_ = toS<S>(exact(settings::kSleepAngularSpeed));
   ticksToSleep_ = std::max<int32_t>(1, int32_t(*div(exact(settings::kSleepTime), s.timeStep)->roundToInt64()));

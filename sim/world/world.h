@@ -96,6 +96,8 @@ class World final : public SimWorld {
   bool runParticleRows(Stage stage, Fn&& rowKernel);
   void applyCommands(const TickInput& input);
   void resetBody(size_t body);
+  /// BodyCommandKind::DragTo: the mouse-drag spring pulls the centre of mass toward `target` (m).
+  void applyDrag(RigidBody<S>& b, const Vec3<S>& target);
   void wakeBodiesNear(const Vec3<S>& centre,
                       S radius);  ///< every sleeping body whose bounds come within 5 cm (per axis)
   /// Wakes `body` and every sleeping body near it, transitively (sim/bodies/sleep_islands.h).
@@ -160,7 +162,9 @@ class World final : public SimWorld {
   S maxAngularSpeed_{};                       ///< rad/s: a quarter turn per sub-step
   S speculativeDistance_{};                   ///< m (settings::kSpeculativeDistance)
   S sleepLinear_{}, sleepAngular_{};
-  S grassDragDt_{};  ///< grassDrag * dt (N s/m * s = kg per tuft)
+  S grassDragDt_{};                  ///< grassDrag * dt (N s/m * s = kg per tuft)
+  Softness<S> dragSoftness_{};       ///< the DragTo spring over one tick
+  S dragMaxOffset_{}, dragMaxDv_{};  ///< m and m/s per axis (settings::kDragMaxOffset, kDragMaxSpeedChange)
   int32_t ticksToSleep_ = 30;
   std::vector<S> dispX_, dispY_, dispZ_;  ///< per-particle tip displacement (patch-state scratch)
   std::vector<S> rowScratch_;             ///< per-worker interpolation row
