@@ -56,8 +56,8 @@ TEST(CliTour, StageTimesNameTheFusedRodProjection) {
 TEST(CliTour, RecordTakesRunsFlagsAsVariants) {
   TempDir dir;
   const std::string scenario = quote(scenarioPath("lod-crossing.json"));
-  const CliResult flag = runCli("record " + scenario + " --lod off --scalar fx16 --ticks 8 -o " +
-                                quote(dir.file("flag.sgr")) + " --json");
+  const CliResult flag =
+      runCli("record " + scenario + " --lod off --scalar fx16 --ticks 8 -o " + quote(dir.file("flag.sgr")) + " --json");
   ASSERT_EQ(flag.exitCode, 0) << flag.describe();
   const CliResult variant = runCli("record " + scenario + " --variant lod=off --variant scalar=fx16 --ticks 8 -o " +
                                    quote(dir.file("variant.sgr")) + " --json");
@@ -107,9 +107,8 @@ TEST(CliTour, SweepWritesIntoTheCurrentFolderByDefault) {
   TempDir dir;
   std::filesystem::create_directories(dir.file("docs/results"));
   const std::string committed = dir.write("docs/results/sweep.json", "{\"committed\": true}\n");
-  const std::string tiny = dir.write(
-      "tiny.json",
-      R"({"format": "simgrass-scenario/1", "name": "tiny", "timeStep": "1/60",
+  const std::string tiny = dir.write("tiny.json",
+                                     R"({"format": "simgrass-scenario/1", "name": "tiny", "timeStep": "1/60",
           "field": {"patchesX": 21, "patchesZ": 21, "spacing": 0.25}, "lod": {"mode": "off"}})");
   const CliResult r = runCli("sweep --scenarios " + quote(tiny) +
                                  " --seconds 0.05 --repeats 1 --scalars fx32 --k 1 --dt 1/60 --lod off --json",

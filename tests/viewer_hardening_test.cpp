@@ -16,8 +16,8 @@
 
 namespace sg {
 namespace viewer_test {
-bool onPath(const std::string& program);                         // tests/viewer_test.cpp
-CliResult runViewer(const std::string& args, bool xvfb = true);  // tests/viewer_test.cpp
+bool onPath(const std::string& program);                                                      // tests/viewer_test.cpp
+CliResult runViewer(const std::string& args, bool xvfb = true, const std::string& cwd = "");  // tests/viewer_test.cpp
 }  // namespace viewer_test
 
 namespace {

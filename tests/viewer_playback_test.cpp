@@ -14,8 +14,9 @@
 
 namespace sg {
 namespace viewer_test {
-bool onPath(const std::string& program);                         // tests/viewer_test.cpp
-CliResult runViewer(const std::string& args, bool xvfb = true);  // tests/viewer_test.cpp
+bool onPath(const std::string& program);  // tests/viewer_test.cpp
+CliResult runViewer(const std::string& args, bool xvfb = true,
+                    const std::string& cwd = "");  // tests/viewer_test.cpp
 }  // namespace viewer_test
 
 namespace {
@@ -112,11 +113,15 @@ TEST(ViewerPlayback, AbOfARecordingWithItselfIsZeroAndUnderAVariantMatchesCompar
   const double worst = variant.value("tipMax", -1.0);
   ASSERT_GT(first, 0);
   ASSERT_GT(worst, 0);
+  ASSERT_GT(worstTick, first) << "the first print seeks past the first divergent tick";
 
-  // Step from 0 past compare's first divergent tick, then jump to its worst tick.
+  // First a jump past everything (the first divergent tick must not depend on what was seen:
+  // it is the whole run's, as compare finds it), then step from 0 past compare's first divergent
+  // tick, then jump to its worst tick.
   const std::string script =
-      dir.write("ab.txt", "step " + std::to_string(first + 2) + "\nprint\nab overlay\nframes 1\n" + "seek " +
-                              std::to_string(worstTick) + "\nprint\nab side\nframes 1\nquit\n");
+      dir.write("ab.txt", "seek " + std::to_string(worstTick) + "\nprint\nseek 0\nstep " + std::to_string(first + 2) +
+                              "\nprint\nab overlay\nframes 1\n" + "seek " + std::to_string(worstTick) +
+                              "\nprint\nab side\nframes 1\nquit\n");
   const CliResult self = runViewer(quote(rec) + " --ab " + quote(rec) + " --script " + quote(script) + kWindow);
   ASSERT_EQ(self.exitCode, 0) << self.describe();
   for (const StateLine& s : stateLines(self.out)) {
@@ -126,8 +131,10 @@ TEST(ViewerPlayback, AbOfARecordingWithItselfIsZeroAndUnderAVariantMatchesCompar
 
   const CliResult ab = runViewer(quote(rec) + " --ab-variant interp=2 --script " + quote(script) + kWindow);
   ASSERT_EQ(ab.exitCode, 0) << ab.describe();
-  const std::vector<StateLine> s = stateLines(ab.out);
-  ASSERT_EQ(s.size(), 2u) << ab.describe();
+  const std::vector<StateLine> all = stateLines(ab.out);
+  ASSERT_EQ(all.size(), 3u) << ab.describe();
+  EXPECT_EQ(all[0].firstDivergent, first) << "after a seek past it: " << all[0].text;
+  const std::vector<StateLine> s(all.begin() + 1, all.end());
   EXPECT_EQ(s[0].firstDivergent, first) << s[0].text;
   EXPECT_GT(s[0].tipMax, 0.0) << s[0].text;
   EXPECT_EQ(s[1].tick, worstTick);

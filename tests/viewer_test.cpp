@@ -17,16 +17,17 @@ bool onPath(const std::string& program) {
   return std::system(("command -v " + program + " >/dev/null 2>&1").c_str()) == 0;
 }
 
-/// Runs `simgrass-viewer <args>` under `xvfb-run -a` (stdout and stderr captured), 120 s at most.
-CliResult runViewer(const std::string& args, bool xvfb = true) {
+/// Runs `simgrass-viewer <args>` under `xvfb-run -a` (stdout and stderr captured), 120 s at most,
+/// in folder `cwd` (default: the test's own).
+CliResult runViewer(const std::string& args, bool xvfb = true, const std::string& cwd = "") {
   TempDir dir;
   const std::string out = dir.file("stdout"), err = dir.file("stderr");
   // xvfb-run's own temporary folder (X authority file) goes into this test's folder: in the
   // shared /tmp another process's clean-up could remove it first and fail the run (exit 5).
   const std::string prefix =
       xvfb ? "env TMPDIR=" + quote(dir.file("")) + " xvfb-run -a -s '-screen 0 1024x768x24' " : "";
-  const std::string cmd = "timeout -k 5 120 " + prefix + quote(SIMGRASS_VIEWER) + " " + args + " </dev/null >" +
-                          quote(out) + " 2>" + quote(err);
+  const std::string cmd = (cwd.empty() ? std::string() : "cd " + quote(cwd) + " && ") + "timeout -k 5 120 " + prefix +
+                          quote(SIMGRASS_VIEWER) + " " + args + " </dev/null >" + quote(out) + " 2>" + quote(err);
   // xvfb-run sometimes fails its own clean-up after a viewer that exits within a fraction of a
   // second (its `rm -r` of the X authority folder races the X server's start-up) and then
   // replaces the viewer's exit code with 5. That is the harness, not the viewer: run it again

@@ -103,11 +103,19 @@ bool App::open(std::string* error) {
   if (!live_->scenarioDir.empty()) renderer_->setAssetDirectory(live_->scenarioDir);
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
-  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini next to the user's files
+  // The layout lives with the app's settings (settings.h), never next to the user's files; a
+  // scripted run without --config-dir keeps none.
+  ImGui::GetIO().IniFilename = imguiIni_.empty() ? nullptr : imguiIni_.c_str();
   ImGui::StyleColorsDark();
   ImGui_ImplGlfw_InitForOpenGL(window_, true);
   ImGui_ImplOpenGL3_Init("#version 330");
   imgui_ = true;
+  // Ours after ImGui's: every key, character and button reaches App::deliver first, which hands
+  // it to ImGui's callback (saved here) or to the app, never both (input_events.h).
+  glfwSetWindowUserPointer(window_, this);
+  uiKey_ = glfwSetKeyCallback(window_, &App::onKey);
+  uiChar_ = glfwSetCharCallback(window_, &App::onChar);
+  uiMouseButton_ = glfwSetMouseButtonCallback(window_, &App::onMouseButton);
   return true;
 }
 
@@ -126,6 +134,7 @@ void App::close() {
 
 int App::finish(int code) {
   if (recordingFailed_ && code == kExitOk) code = kExitFailure;  // a recording lost ticks: not a clean run
+  saveSettings();
   if (live_->recorder) {
     std::string e;
     if (!live_->stopRecording(&e) && code == kExitOk) {
@@ -137,19 +146,6 @@ int App::finish(int code) {
   std::fflush(stdout);
   close();
   return code;
-}
-
-bool App::key(int k) const {
-  if (scripted_) return scriptKeys_[size_t(k)];
-  if (imgui_ && ImGui::GetIO().WantCaptureKeyboard) return false;
-  return glfwGetKey(window_, k) == GLFW_PRESS;
-}
-
-bool App::pressed(int k) {
-  const bool down = key(k);
-  const bool edge = down && !wasDown_[size_t(k)];
-  wasDown_[size_t(k)] = down;
-  return edge;
 }
 
 void App::showError(const std::string& message) {
@@ -164,20 +160,40 @@ TickInput App::tickInput() {
   TickInput in;
   in.hasCamera = true;
   in.camera = {toRaw(cam_.camera.x), toRaw(cam_.camera.y), toRaw(cam_.camera.z)};
+  // F3 off: the simulated window stays where it stood (the thesis' "grass follows camera" off).
+  if (!grassFollows_) in.camera = frozenCamera_;
   // The scenario's own scripted commands still play (the thesis scene kicks the football); the
   // user's commands come after them. Its camera track is replaced by the user's camera.
   const Session& s = *live_;
   if (!opt_.noScenarioInput) in.bodies = scriptedInput(s.scenario, s.world->tick()).bodies;
-  // One-shot commands (reset, spawn, mower) go into the first tick after the key.
-  in.bodies.insert(in.bodies.end(), pendingCommands_.begin(), pendingCommands_.end());
-  pendingCommands_.clear();
+  // One-shot commands (reset, spawn, mower, shoot) go into the first tick after the key. A
+  // shot's AddVelocity names the body its Spawn makes: the next index after every body and every
+  // spawn before it in this tick (kShotBody marks it until then).
   const int64_t bodies = s.world->counts().bodies;
+  for (BodyCommand c : pendingCommands_) {
+    if (c.body == kShotBody) {
+      const auto spawns = std::count_if(in.bodies.begin(), in.bodies.end(),
+                                        [](const BodyCommand& b) { return b.kind == BodyCommandKind::Spawn; });
+      c.body = int32_t(bodies + spawns - 1);
+    }
+    in.bodies.push_back(c);
+  }
+  pendingCommands_.clear();
+  // The mouse drag: the spring's target for the grabbed body's centre of mass, every tick it is held.
+  if (dragging_ && dragBody_ >= 0 && dragBody_ < bodies) {
+    BodyCommand c;
+    c.body = dragBody_;
+    c.kind = BodyCommandKind::DragTo;
+    c.value = {toRaw(dragPoint_[0] + dragOffset_[0]), toRaw(dragPoint_[1] + dragOffset_[1]),
+               toRaw(dragPoint_[2] + dragOffset_[2])};
+    in.bodies.push_back(c);
+  }
   if (selected_ < 0 || selected_ >= bodies) return in;
   float fx, fz, rx, rz;
   cam_.groundAxes(&fx, &fz, &rx, &rz);
-  const float f = float(key(GLFW_KEY_T)) - float(key(GLFW_KEY_G));
-  const float r = float(key(GLFW_KEY_H)) - float(key(GLFW_KEY_F));
-  const float u = float(key(GLFW_KEY_U)) - float(key(GLFW_KEY_J));
+  const float f = float(held(GLFW_KEY_T)) - float(held(GLFW_KEY_G));
+  const float r = float(held(GLFW_KEY_H)) - float(held(GLFW_KEY_F));
+  const float u = float(held(GLFW_KEY_U)) - float(held(GLFW_KEY_J));
   if (f == 0 && r == 0 && u == 0) return in;
   const double dt = s.scenario.timeStep.toDouble();
   const double scale = positionMode_ ? cam_.tune.bodySpeed * dt : cam_.tune.bodyAcceleration * dt;
@@ -213,58 +229,12 @@ void App::queueBodyCommand(BodyCommandKind kind) {
   pendingCommands_.push_back(c);
 }
 
-void App::handleToggles() {
-  std::string error;
-  if (pressed(GLFW_KEY_C)) cam_.free = !cam_.free;
-  if (pressed(GLFW_KEY_V) && play_ && play_->hasB()) abView_ = abView_ == AbView::Side ? AbView::Overlay : AbView::Side;
-  if (!scripted_ && pressed(GLFW_KEY_ESCAPE)) {
-    if (play_ && play_->busy()) {  // Escape first cancels a pending seek, then quits
-      play_->cancel();
-      status_ = "seek cancelled at tick " + std::to_string(play_->tick());
-    } else {
-      glfwSetWindowShouldClose(window_, GLFW_TRUE);
-    }
-  }
-  if (play_) {
-    if (pressed(GLFW_KEY_SPACE)) play_->playing = !play_->playing;
-    if (pressed(GLFW_KEY_PERIOD)) {
-      play_->playing = false;
-      if (!play_->step(1, &error)) showError(error);
-    }
-    if (pressed(GLFW_KEY_HOME) && !play_->seek(0, &error)) showError(error);
-    return;
-  }
-  const int64_t bodies = live_->world->counts().bodies;
-  if (pressed(GLFW_KEY_TAB) && bodies > 0) selected_ = int((selected_ + 1) % bodies);
-  if (pressed(GLFW_KEY_P)) positionMode_ = !positionMode_;
-  if (pressed(GLFW_KEY_M)) {
-    const bool on = size_t(selected_) < mowerOn_.size() ? mowerOn_[size_t(selected_)] : true;
-    queueBodyCommand(on ? BodyCommandKind::MowerOff : BodyCommandKind::MowerOn);
-  }
-  const bool backspace = pressed(GLFW_KEY_BACKSPACE), z = pressed(GLFW_KEY_Z);  // both edges tracked
-  if (backspace || z) queueBodyCommand(BodyCommandKind::Reset);
-  if (pressed(GLFW_KEY_N)) queueBodyCommand(BodyCommandKind::Spawn);
-  if (pressed(GLFW_KEY_R)) {
-    if (live_->recorder) {
-      status_ = live_->stopRecording(&error) ? "saved " + live_->recordPath : error;
-    } else {
-      // The scenario's name comes from its JSON: only letters, digits, '-' and '_' of it, at most
-      // 40, go into the file name (a name like "../../x" must not pick the folder).
-      std::string name;
-      for (char ch : live_->scenario.name)
-        if (name.size() < 40 && (std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_')) name += ch;
-      const std::string path =
-          "simgrass-" + (name.empty() ? std::string("session") : name) + "-" +
-          std::to_string(std::chrono::system_clock::now().time_since_epoch().count() / 1000000000) + ".sgr";
-      status_ = live_->startRecording(path, &error) ? "" : error;
-    }
-  }
-}
-
 // ---- simulation -------------------------------------------------------------------------------
 
 bool App::simulate(double wall, std::string* error) {
   if (play_) {
+    // A/B: the whole run's divergence scan goes on a slice a frame, whatever else happens.
+    if (play_->hasB() && !play_->scanDone()) play_->scanWork(scripted_ ? kScriptedSeekSeconds : kSeekSecondsPerFrame);
     // Playback: `wall` seconds are wall/dt recorded ticks at speed 1 (a scripted frame: one).
     const double dt = play_->scenario().timeStep.toDouble();
     if (play_->busy()) {
@@ -283,16 +253,28 @@ bool App::simulate(double wall, std::string* error) {
   }
   const double dt = live_->scenario.timeStep.toDouble();
   int steps = 1;
-  if (!scripted_) {
+  if (paused_) {
+    // Paused: only the ticks asked for (. or `step N`), a frame's worth at most 8 at a time.
+    steps = int(std::min<int64_t>(liveStepsPending_, scripted_ ? liveStepsPending_ : 8));
+    liveStepsPending_ -= steps;
+    accumulator_ = 0;
+  } else if (!scripted_) {
     accumulator_ = std::min(accumulator_ + wall, 0.25);
     steps = int(accumulator_ / dt);
     accumulator_ -= steps * dt;
     steps = std::min(steps, 8);
   }
+  const StageClock before = live_->clock;
+  FrameTiming& frame = timing_[timingNext_ % kTimingFrames];
+  frame = FrameTiming{};
+  ++timingNext_;
   for (int i = 0; i < steps; ++i) {
     // The tick before the last of this frame is what display interpolation starts from.
-    if (i + 1 == steps && interpolate_ && !scripted_) extractScene(world(), scenario(), &previous_);
-    const StepResult r = live_->step(tickInput());
+    if (i + 1 == steps && interpolate_ && !scripted_ && !paused_) extractScene(world(), scenario(), &previous_);
+    // Behind the history's end (stepped back), a paused step replays what was done there; any
+    // other tick is a new input and starts a new branch from here (Session::step).
+    const bool replaying = paused_ && live_->world->tick() < live_->historyEnd();
+    const StepResult r = replaying ? live_->replayNext() : live_->step(tickInput());
     if (!live_->recordingError.empty()) {
       showError(live_->recordingError);
       status_ = live_->recordingError;
@@ -304,7 +286,10 @@ bool App::simulate(double wall, std::string* error) {
       return false;
     }
     ++clockTicks_;
+    ++frame.ticks;
   }
+  for (size_t st = 0; st < size_t(Stage::Count); ++st)
+    frame.stageMs[st] = float(double(live_->clock.nanos[st] - before.nanos[st]) / 1e6);
   if (clockTicks_ >= 30) {
     double total = 0;
     for (size_t st = 0; st < size_t(Stage::Count); ++st) {
@@ -401,6 +386,7 @@ bool App::screenshot(const std::string& path, std::string* error) {
 
 int App::run(const std::vector<ScriptCommand>* script, const std::string& startupError) {
   scripted_ = script != nullptr;
+  loadSettings();
   if (scripted_) interpolate_ = false;  // frame-locked runs show exact ticks (screenshots stay exact)
   std::string error;
   if (!open(&error)) {
@@ -409,10 +395,11 @@ int App::run(const std::vector<ScriptCommand>* script, const std::string& startu
     return kExitFailure;
   }
   errorText_ = startupError;
+  if (startupError.empty()) settings_.remember(opt_.input);
   extractScene(world(), scenario(), &scene_);
   cam_.camera = defaultCamera(scene_, world(), float(opt_.width) / float(opt_.height));
   cam_.eyeHeight = cam_.camera.y - groundHeight(world(), cam_.camera.x, cam_.camera.z);
-  render_.alphaToCoverage = samples_ > 0;
+  render_.alphaToCoverage = samples_ > 0 && settings_.alphaToCoverage;
   if (play_) play_->playing = !scripted_;  // interactive: starts playing; scripts start paused
   if (!opt_.record.empty() && !inputNamed(opt_.record).empty()) {
     std::fprintf(stderr, "simgrass-viewer: --record: %s: expected an output file other than the input %s\n",
@@ -448,29 +435,23 @@ int App::run(const std::vector<ScriptCommand>* script, const std::string& startu
     last = now;
     frameMs_ = 0.9 * frameMs_ + 0.1 * wall * 1e3;
 
-    // Mouse look while the right button is held (interactive only).
-    if (!scripted_) {
-      double cx = 0, cy = 0;
-      glfwGetCursorPos(window_, &cx, &cy);
-      const bool held = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS &&
-                        !(ImGui::GetIO().WantCaptureMouse && !looking_);
-      if (held && looking_) cam_.look(float(cx - lastCursorX_), float(cy - lastCursorY_));
-      looking_ = held;
-      lastCursorX_ = cx;
-      lastCursorY_ = cy;
-    }
-    handleToggles();
+    // The cursor (a script's `mouse X Y` places it instead), then the frame's events in order.
+    if (!scripted_) glfwGetCursorPos(window_, &cursorX_, &cursorY_);
+    handleEvents();
+    handleMouse();
     const double dt = scenario().timeStep.toDouble();
     MoveKeys mk;
-    mk.forward = float(key(GLFW_KEY_W)) - float(key(GLFW_KEY_S));
-    mk.right = float(key(GLFW_KEY_D)) - float(key(GLFW_KEY_A));
-    mk.up = float(key(GLFW_KEY_E)) - float(key(GLFW_KEY_Q));
-    mk.fast = key(GLFW_KEY_LEFT_SHIFT);
+    mk.forward = float(held(GLFW_KEY_W)) - float(held(GLFW_KEY_S));
+    mk.right = float(held(GLFW_KEY_D)) - float(held(GLFW_KEY_A));
+    mk.up = float(held(GLFW_KEY_E)) - float(held(GLFW_KEY_Q));
+    mk.fast = held(GLFW_KEY_LEFT_SHIFT) || held(GLFW_KEY_RIGHT_SHIFT);
     cam_.update(mk, scripted_ ? float(dt) : float(wall), ground());
+    if (following_) followSelected();
     if (!simulate(wall, &error)) {
       std::fprintf(stderr, "simgrass-viewer: %s\n", error.c_str());
       return finish(kExitFailure);
     }
+    input_.endFrame();  // this frame's taps have driven its ticks
 
     buildScenes(float(accumulator_ / dt));
     int fbw = 0, fbh = 0;
@@ -482,7 +463,9 @@ int App::run(const std::vector<ScriptCommand>* script, const std::string& startu
       renderMs_ = 0.9 * renderMs_ + 0.1 * std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
     }
     if (imgui_) {
-      drawPanels();
+      if (!uiHidden_) drawPanels();
+      if (play_ && play_->hasB() && abView_ == AbView::Side && fbw > 0) drawAbLabels(fbw, fbh);
+      if (helpShown_) drawHelp();
       ImGui::Render();
       ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     }

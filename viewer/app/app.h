@@ -21,10 +21,13 @@
 #include <vector>
 
 #include "viewer/app/camera_controller.h"
+#include "viewer/app/input_events.h"
 #include "viewer/app/options.h"
+#include "viewer/app/picking.h"
 #include "viewer/app/playback.h"
 #include "viewer/app/script.h"
 #include "viewer/app/session.h"
+#include "viewer/app/settings.h"
 #include "viewer/render/renderer.h"
 #include "viewer/render/scene.h"
 
@@ -32,6 +35,9 @@ namespace sg::viewer {
 
 /// App::runScript / runCommand: go on (any other value is an exit code).
 inline constexpr int kGoOn = -1;
+
+/// A pending AddVelocity of a shot (B) names the body its Spawn will make: resolved in tickInput.
+inline constexpr int32_t kShotBody = -2;
 
 /// Wall time a pending seek or step may take per frame (interactive; scripted runs wait for it
 /// with bigger slices). A seek's length is bounded by the recording's last tick.
@@ -62,24 +68,54 @@ class App {
  private:
   enum class AbView { Side, Overlay };
 
-  // ---- app.cpp: window, loop, input ----
+  // ---- app.cpp: window, loop ----
   bool open(std::string* error);
   void close();
   int finish(int code);
-  bool key(int k) const;
-  bool pressed(int k);  ///< went down since the last frame
+  // ---- app_input.cpp: events, keys, mouse, live control ----
+  /// GLFW callbacks (installed after ImGui's, which they forward to): each event is routed once.
+  static void onKey(GLFWwindow* window, int key, int scancode, int action, int mods);
+  static void onChar(GLFWwindow* window, unsigned int codepoint);
+  static void onMouseButton(GLFWwindow* window, int button, int action, int mods);
+  /// Routes an event to ImGui (through its saved callback) or to the app's queue (InputRouter).
+  void deliver(const InputEvent& e);
+  /// A drive or movement key: held at any time during this frame (keyboard or script).
+  bool held(int k) const { return input_.heldThisFrame(k); }
+  /// The frame's key presses and mouse clicks, in order: toggles, live control, picking.
+  void handleEvents();
+  void handleKeyPress(int key, int mods);
+  void handleMouse();
+  void updateCursorRay();
+  /// Live control: pause, step forward, step back, restart (docs/viewer.md "Live control").
+  void stepLive(int64_t n);
+  void stepLiveBack(int64_t n);
+  void restartLive();
+  void shootBody();
+  void openNeighbourScene(int direction);
+  std::vector<std::string> sceneList() const;
+  void takeScreenshot();
+  void followSelected();
+  void appendSelectionOutline(Scene* scene) const;
   // ---- app_script.cpp ----
   /// Runs script commands until one asks for frames (*frames = N); returns an exit code to stop
   /// with, or -1 to render those frames.
   int runScript(const std::vector<ScriptCommand>& script, int64_t* frames);
   int runCommand(const ScriptCommand& c);
-  void handleToggles();
   /// Advances the simulation for `wall` seconds of wall time (scripted: one tick). False: fault.
   bool simulate(double wall, std::string* error);
   TickInput tickInput();
   void queueBodyCommand(BodyCommandKind kind);
   void buildScenes(float alpha);
   void renderWorld(int fbw, int fbh);
+  /// A/B side by side: the two views' width (each), leaving the panel column on the right.
+  int abViewWidth(int fbw) const;
+  void drawAbLabels(int fbw, int fbh);
+  void drawHelp();
+  void panelTiming();
+  void panelLive();
+  void panelScenes();
+  void loadSettings();
+  void saveSettings();
   bool screenshot(const std::string& path, std::string* error);
   /// The input of this session (script, scenario, recording, A/B file) that `path` names (same
   /// file), or "": outputs never replace an input.
@@ -128,12 +164,38 @@ class App {
   std::unique_ptr<Renderer> renderer_;
   Scene scene_, sceneB_, previous_, shown_;
   bool scripted_ = false;
-  std::array<bool, GLFW_KEY_LAST + 1> scriptKeys_{};
-  std::array<bool, GLFW_KEY_LAST + 1> wasDown_{};
   int samples_ = 0;
+  // Input: the app's events and held keys, where each press went, ImGui's own callbacks.
+  InputState input_;
+  InputRouter router_;
+  GLFWkeyfun uiKey_ = nullptr;
+  GLFWcharfun uiChar_ = nullptr;
+  GLFWmousebuttonfun uiMouseButton_ = nullptr;
+  double cursorX_ = 0, cursorY_ = 0;  ///< window pixels (a script's `mouse X Y` sets them)
   double lastCursorX_ = 0, lastCursorY_ = 0;
   bool looking_ = false;
-  double accumulator_ = 0;  ///< s of wall time not yet simulated (live, interactive)
+  Vec3f rayOrigin_{}, rayDirection_{};  ///< the ray under the cursor, this frame
+  double accumulator_ = 0;              ///< s of wall time not yet simulated (live, interactive)
+  // Live control.
+  bool paused_ = false;
+  int64_t liveStepsPending_ = 0;  ///< ticks the next frame runs while paused (. key, `step N`)
+  bool grassFollows_ = true;      ///< F3 off: the simulated window's camera input stays frozen
+  InputVec3 frozenCamera_{};
+  // Mouse drag (a DragTo command every tick while held).
+  bool dragging_ = false;
+  int dragBody_ = -1;
+  Vec3f dragOffset_{};  ///< centre of mass minus the grabbed point (m)
+  Vec3f dragPoint_{};   ///< the grabbed point's target: on the plane facing the camera
+  Vec3f dragNormal_{};
+  // Camera following the selected body (L).
+  bool following_ = false;
+  Vec3f followOffset_{}, followCentre_{};
+  // UI.
+  bool uiHidden_ = false, helpShown_ = false;
+  ViewerSettings settings_;
+  std::string configDir_;  ///< where settings live ("" : nowhere, as in scripted runs)
+  std::string imguiIni_;   ///< ImGui's layout file (kept alive for io.IniFilename)
+  int64_t screenshots_ = 0;
   // Bodies.
   int selected_ = 0;
   bool positionMode_ = false;
@@ -152,7 +214,15 @@ class App {
   std::string errorText_;   ///< the error window's line ("" when closed)
   std::string status_;
   bool recordingFailed_ = false;  ///< a recording stopped on a write error (exit code 1 at the end)
-  // Stats.
+  // Stats: averages, and per-frame stage times for the timing graph (a ring of kTimingFrames).
+  static constexpr size_t kTimingFrames = 240;
+  struct FrameTiming {
+    std::array<float, size_t(Stage::Count)> stageMs{};  ///< summed over the frame's ticks
+    float renderMs = 0;
+    int ticks = 0;
+  };
+  std::array<FrameTiming, kTimingFrames> timing_{};
+  size_t timingNext_ = 0;
   double renderMs_ = 0, frameMs_ = 0;
   std::array<double, size_t(Stage::Count)> stageMs_{};
   double simMsPerTick_ = 0;

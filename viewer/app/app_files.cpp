@@ -33,10 +33,15 @@ bool App::openFile(const std::string& path) {
     showError(e.what());
     return false;
   }
+  settings_.remember(path);
   selected_ = 0;
   mowerOn_.clear();
   pendingCommands_.clear();
   accumulator_ = 0;
+  paused_ = false;
+  liveStepsPending_ = 0;
+  dragging_ = following_ = false;
+  previous_.tick = -1;
   errorText_.clear();
   stagedJson_.reset();  // `set` edits staged for the previous scenario
   resetEdits();

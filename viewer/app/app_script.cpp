@@ -31,6 +31,16 @@ void App::printState() const {
 void App::printStatus() const {
   std::printf("status     %s\n", status_.empty() ? "-" : status_.c_str());
   std::printf("error      %s\n", errorText_.empty() ? "-" : errorText_.c_str());
+  const Camera& c = cam_.camera;
+  std::printf("camera     %.4f %.4f %.4f %.3f %.3f\n", c.x, c.y, c.z, c.yawDegrees, c.pitchDegrees);
+  const WorldCounts counts = world().counts();
+  if (counts.lodWindow)
+    std::printf("window     %" PRId64 " %" PRId64 "\n", counts.windowOriginI, counts.windowOriginJ);
+  else
+    std::printf("window     off\n");
+  std::printf("view       panels %s, help %s, %s, selected %d%s, grass %s\n", uiHidden_ ? "hidden" : "shown",
+              helpShown_ ? "shown" : "hidden", paused_ ? "paused" : "running", selected_,
+              following_ ? " (followed)" : "", grassFollows_ ? "follows the camera" : "frozen");
   std::fflush(stdout);
 }
 
@@ -51,8 +61,32 @@ int App::runCommand(const ScriptCommand& c) {
   switch (c.kind) {
     case K::Frames:
       return kGoOn;  // handled by the caller
-    case K::Key:
-      scriptKeys_[size_t(c.key)] = c.down;
+    case K::Key:     // through the event queue, as the keyboard's callback does
+      deliver(InputEvent{InputEvent::Kind::Key, c.key, c.down, false, 0});
+      return kGoOn;
+    case K::Tap:  // down and up before the next frame: the tap must still act (and drive a frame)
+      deliver(InputEvent{InputEvent::Kind::Key, c.key, true, false, 0});
+      deliver(InputEvent{InputEvent::Kind::Key, c.key, false, false, 0});
+      return kGoOn;
+    case K::Mouse:
+      cursorX_ = c.camera[0];
+      cursorY_ = c.camera[1];
+      return kGoOn;
+    case K::Button:
+      deliver(InputEvent{InputEvent::Kind::MouseButton, c.key, c.down, false, 0});
+      return kGoOn;
+    case K::Back:
+      if (play_) {
+        play_->playing = false;
+        if (!play_->seek(std::max<int64_t>(play_->recording().header.startTick, play_->tick() - c.count), &error))
+          showError(error);
+      } else {
+        stepLiveBack(c.count);
+      }
+      return kGoOn;
+    case K::Restart:
+      if (play_) return bad("restart: expected a live session (a playback goes back with 'seek 0')");
+      restartLive();
       return kGoOn;
     case K::Camera:
       cam_.place(c.camera[0], c.camera[1], c.camera[2], c.camera[3], c.camera[4], ground());
@@ -81,11 +115,17 @@ int App::runCommand(const ScriptCommand& c) {
       return kExitOk;
     case K::Play:
     case K::Pause:
-      if (!play_) return needPlayback(c.kind == K::Play ? "play" : "pause");
+      if (!play_) {  // live: resume / pause the session
+        paused_ = c.kind == K::Pause;
+        return kGoOn;
+      }
       play_->playing = c.kind == K::Play;
       return kGoOn;
     case K::Step:
-      if (!play_) return needPlayback("step");
+      if (!play_) {  // live: the next `frames` run these ticks, then stay paused
+        stepLive(c.count);
+        return kGoOn;
+      }
       play_->playing = false;
       if (!play_->step(c.count, &error)) showError(error);
       return kGoOn;
@@ -155,6 +195,12 @@ int App::runScript(const std::vector<ScriptCommand>& script, int64_t* frames) {
     // A seek or step under way runs frame by frame (App::simulate); the script waits for it, so
     // the next command sees the tick it asked for.
     if (play_ && play_->busy()) {
+      *frames = 0;
+      return kGoOn;
+    }
+    // `print` in A/B mode reports the whole run's first divergent tick: it waits for the scan.
+    if (scriptNext_ < script.size() && script[scriptNext_].kind == ScriptCommand::Kind::Print && play_ &&
+        play_->hasB() && !play_->scanDone()) {
       *frames = 0;
       return kGoOn;
     }

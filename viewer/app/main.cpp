@@ -6,6 +6,7 @@
 #include "replay/input_file.h"
 #include "replay/kernel_environment.h"
 #include "viewer/app/app.h"
+#include "viewer/app/keys.h"
 
 int main(int argc, char** argv) {
   using namespace sg;
@@ -16,6 +17,11 @@ int main(int argc, char** argv) {
   }
   Options o;
   if (const int code = parseOptions(argc, argv, &o); code >= 0) return code;
+  if (o.keys) {  // the F1 help as docs/viewer.md's Controls table (tests compare the two)
+    std::printf("| Keys | What |\n|------|------|\n");
+    for (const KeyHelp& k : kKeyHelp) std::printf("| %s | %s |\n", k.keys, k.what);
+    return kExitOk;
+  }
   std::vector<ScriptCommand> script;
   if (!o.script.empty()) {
     // The bounded reader: a FIFO or /dev/zero is refused at once, a huge file before any read.

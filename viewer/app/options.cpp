@@ -41,6 +41,10 @@ int parseOptions(int argc, char** argv, Options* o) {
   app.add_flag("--keep-open-on-error", o->keepOpenOnError,
                "A bad input file opens the window anyway (built-in meadow) and shows the error there");
   app.add_option("--threads", o->threads, "Simulation worker threads")->check(CLI::Range(1, 256));
+  app.add_option("--config-dir", o->configDir,
+                 "Folder of the settings kept between runs (viewer.json, imgui.ini); default "
+                 "$XDG_CONFIG_HOME/simgrass or ~/.config/simgrass, none for --script runs");
+  app.add_flag("--keys", o->keys, "Print every key and mouse control (the F1 help) and exit");
   app.footer("Exit codes: 0 ok, 1 no window / OpenGL, simulation fault or I/O error, 2 bad input.");
   try {
     app.parse(argc, argv);

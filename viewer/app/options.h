@@ -23,6 +23,8 @@ struct Options {
   int msaa = 4;
   bool noScenarioInput = false;
   bool keepOpenOnError = false;    ///< a bad input file opens the window with the error shown
+  std::string configDir;           ///< --config-dir: settings and ImGui layout (settings.h)
+  bool keys = false;               ///< --keys: print the key table and exit
   int width = 1280, height = 720;  ///< parsed from `size`
 };
 

@@ -4,23 +4,45 @@
 // from the edited scenario text (App::applyScenario), one-shot body actions become recorded inputs.
 #include <imgui.h>
 
+#include <algorithm>
 #include <cinttypes>
 #include <cstdio>
 
 #include "viewer/app/app.h"
+#include "viewer/app/keys.h"
 #include "viewer/app/text.h"
 
 namespace sg::viewer {
 
+int App::abViewWidth(int fbw) const {
+  // Side by side, the two views share what the panel column leaves (the whole width when the
+  // panels are hidden): panels never cover either view.
+  const int column = uiHidden_ ? 0 : std::min(360, fbw / 3);
+  return std::max(1, (fbw - column) / 2);
+}
+
 void App::drawPanels() {
-  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
-  ImGui::Begin("SimGrass");
+  const bool abSide = play_ && play_->hasB() && abView_ == AbView::Side;
+  if (abSide) {  // docked in the column right of the two views
+    const ImVec2 size = ImGui::GetIO().DisplaySize;
+    const float x = float(2 * abViewWidth(int(size.x)));
+    ImGui::SetNextWindowPos(ImVec2(x, 0), ImGuiCond_Always);
+    ImGui::SetNextWindowSize(ImVec2(std::max(1.0f, size.x - x), size.y), ImGuiCond_Always);
+  } else {
+    ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
+  }
+  ImGui::Begin("SimGrass", nullptr, abSide ? ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize : 0);
+  ImGui::TextDisabled("F1 help, F2 hide panels");
   panelStats();
+  panelTiming();
   panelOpen();
+  panelScenes();
   if (play_) {
     panelPlayback();
     if (play_->hasB()) panelAb();
+  } else {
+    panelLive();
   }
   panelCamera();
   panelVisuals();
@@ -95,7 +117,8 @@ void App::panelPlayback() {
     ImGui::TextColored(ImVec4(1, 0.25f, 0.25f, 1), "hash MISMATCH at tick %" PRId64, play_->firstMismatchTick());
     ImGui::TextColored(ImVec4(1, 0.25f, 0.25f, 1), "%" PRId64 " hashes checked OK", play_->hashesOk());
   } else {
-    ImGui::TextColored(ImVec4(0.4f, 1, 0.4f, 1), "%" PRId64 " recorded hashes checked OK", play_->hashesOk());
+    ImGui::TextColored(ImVec4(0.4f, 1, 0.4f, 1), "%" PRId64 " of %" PRId64 " hashed ticks checked OK",
+                       play_->hashesOk(), play_->recording().hashedTicks());
   }
 }
 
@@ -116,10 +139,149 @@ void App::panelAb() {
   } else {
     ImGui::TextDisabled("B is between steps (coarser time step)");
   }
-  if (play_->firstDivergentTick() >= 0)
-    ImGui::Text("first divergent tick so far: %" PRId64, play_->firstDivergentTick());
+  // The whole run's first divergent tick, as `simgrass diff`/`compare` find it (a scan of every
+  // common tick from the start, whatever has been seeked: Playback::scanDivergence).
+  if (play_->scanDone() && play_->firstDivergentTick() >= 0)
+    ImGui::Text("first divergent tick: %" PRId64 " (by %s)", play_->firstDivergentTick(), play_->divergenceBy());
+  else if (play_->scanDone())
+    ImGui::Text("identical (by %s)", play_->divergenceBy());
   else
-    ImGui::Text("no divergence so far");
+    ImGui::Text("first divergent tick: scanning, none up to tick %" PRId64, play_->scannedTo());
+}
+
+void App::panelLive() {
+  if (!ImGui::CollapsingHeader("Live", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  ImGui::Text("tick %" PRId64 " of %" PRId64 " in the history%s", live_->world->tick(), live_->historyEnd(),
+              paused_ ? ", paused" : "");
+  if (ImGui::Button(paused_ ? "Resume (Space)" : "Pause (Space)")) paused_ = !paused_;
+  ImGui::SameLine();
+  if (ImGui::Button("Back (,)")) stepLiveBack(1);
+  ImGui::SameLine();
+  if (ImGui::Button("Step (.)")) stepLive(1);
+  ImGui::SameLine();
+  if (ImGui::Button("Restart (Home)")) restartLive();
+  // Scrubbing moves through the session's own history (kept states every snapshotEvery ticks and
+  // the inputs); resuming, or any new input, continues from the tick shown.
+  int64_t t = scrubbing_ ? scrubTick_ : live_->world->tick();
+  const int64_t lo = 0, hi = std::max<int64_t>(1, live_->historyEnd());
+  ImGui::SliderScalar("history", ImGuiDataType_S64, &t, &lo, &hi);
+  scrubbing_ = ImGui::IsItemActive();
+  scrubTick_ = t;
+  if (ImGui::IsItemDeactivatedAfterEdit()) {
+    paused_ = true;
+    stepLiveBack(live_->world->tick() - std::min(t, live_->historyEnd()));
+  }
+  ImGui::TextDisabled("states kept every %" PRId64 " ticks (%zu)", live_->snapshotEvery(), live_->snapshotCount());
+  if (ImGui::Checkbox("grass follows camera (F3)", &grassFollows_) && !grassFollows_)
+    frozenCamera_ = {toRaw(cam_.camera.x), toRaw(cam_.camera.y), toRaw(cam_.camera.z)};
+}
+
+void App::panelScenes() {
+  if (!ImGui::CollapsingHeader("Scenes")) return;
+  ImGui::TextDisabled("Page Down / Page Up: next / previous");
+  for (const std::string& f : sceneList())
+    if (ImGui::Selectable(f.c_str(), !play_ && f == live_->scenario.sourceName)) openFile(f);
+  if (!settings_.recent.empty()) {
+    ImGui::Separator();
+    ImGui::TextDisabled("recent");
+    const std::vector<std::string> recent = settings_.recent;  // openFile changes the list
+    for (size_t k = 0; k < recent.size(); ++k) {
+      ImGui::PushID(int(k));
+      const bool open = ImGui::Selectable(recent[k].c_str(), false);
+      ImGui::PopID();
+      if (open) openFile(recent[k]);
+    }
+  }
+}
+
+void App::panelTiming() {
+  if (!ImGui::CollapsingHeader("Timing", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  // The last kTimingFrames frames as stacked bars: each timed stage of the frame's ticks, then the
+  // render, in ms (the graph's top is the largest frame's total, at least 1 ms).
+  static constexpr ImU32 kColours[] = {IM_COL32(120, 120, 120, 255), IM_COL32(160, 160, 60, 255),
+                                       IM_COL32(80, 160, 230, 255),  IM_COL32(230, 120, 40, 255),
+                                       IM_COL32(230, 60, 60, 255),   IM_COL32(60, 200, 90, 255),
+                                       IM_COL32(0, 0, 0, 0),         IM_COL32(180, 90, 220, 255)};
+  const ImU32 renderColour = IM_COL32(90, 90, 200, 255);
+  float top = 1;
+  for (const FrameTiming& f : timing_) {
+    float sum = f.renderMs;
+    for (float v : f.stageMs) sum += v;
+    top = std::max(top, sum);
+  }
+  const ImVec2 origin = ImGui::GetCursorScreenPos();
+  const float width = std::max(50.0f, ImGui::GetContentRegionAvail().x), height = 70;
+  ImDrawList* dl = ImGui::GetWindowDrawList();
+  dl->AddRectFilled(origin, ImVec2(origin.x + width, origin.y + height), IM_COL32(20, 20, 20, 255));
+  const float bar = width / float(kTimingFrames);
+  for (size_t k = 0; k < kTimingFrames; ++k) {
+    const FrameTiming& f = timing_[(timingNext_ + k) % kTimingFrames];  // oldest on the left
+    float y = origin.y + height;
+    const float x = origin.x + float(k) * bar;
+    auto stack = [&](float ms, ImU32 colour) {
+      const float h = ms / top * height;
+      dl->AddRectFilled(ImVec2(x, y - h), ImVec2(x + std::max(1.0f, bar), y), colour);
+      y -= h;
+    };
+    for (size_t st = 0; st < size_t(Stage::Count); ++st)
+      if (stageIsTimed(Stage(st))) stack(f.stageMs[st], kColours[st]);
+    stack(f.renderMs, renderColour);
+  }
+  ImGui::Dummy(ImVec2(width, height));
+  ImGui::Text("top %.2f ms", top);
+  for (size_t st = 0; st < size_t(Stage::Count); ++st) {
+    if (!stageIsTimed(Stage(st))) continue;
+    ImGui::ColorButton(timedStageName(Stage(st)), ImGui::ColorConvertU32ToFloat4(kColours[st]),
+                       ImGuiColorEditFlags_NoTooltip, ImVec2(10, 10));
+    ImGui::SameLine();
+    ImGui::Text("%s", timedStageName(Stage(st)));
+  }
+  ImGui::ColorButton("render", ImGui::ColorConvertU32ToFloat4(renderColour), ImGuiColorEditFlags_NoTooltip,
+                     ImVec2(10, 10));
+  ImGui::SameLine();
+  ImGui::Text("render");
+}
+
+void App::drawAbLabels(int fbw, int fbh) {
+  // Window coordinates (ImGui's) may differ from framebuffer pixels on scaled displays.
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  const float scale = display.x / float(std::max(1, fbw));
+  const float w = float(abViewWidth(fbw)) * scale;
+  ImDrawList* dl = ImGui::GetForegroundDrawList();
+  dl->AddLine(ImVec2(w, 0), ImVec2(w, float(fbh) * scale), IM_COL32(255, 255, 255, 230), 3.0f);
+  auto label = [&](float x, const std::string& text) {
+    const ImVec2 size = ImGui::CalcTextSize(text.c_str());
+    dl->AddRectFilled(ImVec2(x + 6, 6), ImVec2(x + 14 + size.x, 12 + size.y), IM_COL32(0, 0, 0, 170));
+    dl->AddText(ImVec2(x + 10, 9), IM_COL32(255, 255, 255, 255), text.c_str());
+  };
+  label(0, "A  " + play_->recording().file);
+  std::string b = "B  " + play_->labelB();
+  if (play_->measured()) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "   tip max %.3g m", play_->divergence().tipMax);
+    b += buf;
+  }
+  label(w, b);
+}
+
+void App::drawHelp() {
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  ImGui::SetNextWindowPos(ImVec2(display.x * 0.5f, display.y * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowBgAlpha(0.9f);
+  bool open = true;
+  ImGui::Begin("Keys (F1 or ? closes)", &open, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoCollapse);
+  if (ImGui::BeginTable("keys", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
+    for (const KeyHelp& k : kKeyHelp) {
+      ImGui::TableNextRow();
+      ImGui::TableNextColumn();
+      ImGui::TextUnformatted(k.keys);
+      ImGui::TableNextColumn();
+      ImGui::TextUnformatted(k.what);
+    }
+    ImGui::EndTable();
+  }
+  ImGui::End();
+  if (!open) helpShown_ = false;
 }
 
 void App::panelCamera() {
@@ -196,7 +358,7 @@ void App::panelLod() {
   else
     ImGui::Text("off: all %" PRId64 " x %" PRId64 " patches simulated", counts.patchesX, counts.patchesZ);
   bool follows = counts.lodWindow;
-  if (ImGui::Checkbox("grass follows camera", &follows)) {
+  if (ImGui::Checkbox("simulate a window around the camera", &follows)) {
     try {
       applyScenario(editScenarioText(live_->scenario.text, live_->scenario.sourceName, "lod.mode",
                                      follows ? "\"window\"" : "\"off\""),
@@ -234,7 +396,9 @@ void App::panelBodies() {
   }
   const auto& list = live_->scenario.bodies.list;
   const std::string name = size_t(selected_) < list.size() ? list[size_t(selected_)].name : std::string("spawned");
-  ImGui::Text("selected %d/%" PRId64 ": %s (Tab)", selected_, bodies, name.c_str());
+  ImGui::Text("selected %d/%" PRId64 ": %s (Tab or click)", selected_, bodies, name.c_str());
+  bool follow = following_;
+  if (ImGui::Checkbox("camera follows it (L)", &follow)) handleKeyPress(GLFW_KEY_L, 0);
   ImGui::Text("mode: %s (P)", positionMode_ ? "position (Displace)" : "velocity (AddVelocity)");
   ImGui::Text("drive: T/F/G/H, up/down: U/J");
   const bool on = size_t(selected_) < mowerOn_.size() ? mowerOn_[size_t(selected_)] : true;
@@ -244,6 +408,9 @@ void App::panelBodies() {
   if (ImGui::Button("Reset (Z)")) queueBodyCommand(BodyCommandKind::Reset);
   ImGui::SameLine();
   if (ImGui::Button("Spawn (N)")) queueBodyCommand(BodyCommandKind::Spawn);
+  ImGui::SameLine();
+  if (ImGui::Button("Shoot (B)")) shootBody();
+  ImGui::TextDisabled("left drag: pull a body (recorded DragTo)");
 }
 
 void App::panelRecording() {

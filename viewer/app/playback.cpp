@@ -66,8 +66,43 @@ void Playback::buildB() {
     throw std::invalid_argument(labelB_ + ": expected the same meadow and bodies as A, got " + why);
   }
   measured_ = false;
-  firstDivergent_ = -1;
+  // The scan: its own A (the recording at its settings, as compare's reference) and its own B.
+  scanA_ = std::make_unique<LockStepReplay>(*rec_, threads_);
+  scanB_ = std::make_unique<LockStepReplay>(recB_ ? *recB_ : *rec_, threads_, variantB_);
+  scanTo_ = scanFirst_ = -1;
+  scanDone_ = false;
+  scanByHash_ = VariantSettings::resolvedFrom(scanB_->player().scenario())
+                    .mustBeIdenticalTo(VariantSettings::resolvedFrom(scanA_->player().scenario()));
   syncB();
+}
+
+void Playback::scanWork(double seconds) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const int64_t m = scanB_ ? scanB_->mergedTicks() : 1;
+  const int64_t last = std::min(rec_->lastTick(), recB_ ? recB_->lastTick() : rec_->lastTick()) / m * m;
+  while (scanB_ && !scanDone_) {
+    const int64_t target = scanTo_ < 0 ? 0 : scanTo_ + m;
+    if (target > last) {
+      scanDone_ = true;
+      break;
+    }
+    if (!scanA_->advanceTo(target).ok || !scanB_->advanceTo(target).ok) {  // a fault: the scan ends there
+      scanDone_ = true;
+      break;
+    }
+    scanA_->world().observe(scanObsA_);
+    scanB_->world().observe(scanObsB_);
+    const TickDivergence d =
+        measureDivergence(scanObsA_, scanObsB_, scanA_->world().stateHash() == scanB_->world().stateHash());
+    scanTo_ = target;
+    if (scanByHash_ ? !d.identical : d.observedDifference()) {
+      scanFirst_ = target;
+      scanDone_ = true;
+    }
+    if (std::chrono::duration<double>(Clock::now() - start).count() >= seconds) break;
+  }
+  if (scanDone_) scanA_.reset(), scanB_.reset();  // the worlds' memory back
 }
 
 /// B's target for A's tick: the last common tick at or before it (B may end earlier).
@@ -108,7 +143,6 @@ void Playback::measureB() {
   b_->world().observe(obsB_);
   last_ = measureDivergence(obsA_, obsB_, player_->world().stateHash() == b_->world().stateHash());
   measured_ = true;
-  if (last_.observedDifference() && (firstDivergent_ < 0 || t < firstDivergent_)) firstDivergent_ = t;
 }
 
 /// Brings B to A's tick (or the last common tick before it) and measures the divergence there,

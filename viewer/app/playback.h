@@ -80,7 +80,16 @@ class Playback {
   /// The divergence at the last common tick (valid when measured()).
   bool measured() const { return measured_; }
   const TickDivergence& divergence() const { return last_; }
-  int64_t firstDivergentTick() const { return firstDivergent_; }
+  /// The first divergent tick of the whole run, found as `simgrass diff` and `compare` find it:
+  /// a scan of every common tick from the start (two worlds of its own, beside A and B, so seeks
+  /// never change it), by hash when the two runs promise the same states, else by observation.
+  /// -1 while the scan has found none (scanDone() says whether it has finished).
+  int64_t firstDivergentTick() const { return scanFirst_; }
+  bool scanDone() const { return !b_ || scanDone_; }
+  int64_t scannedTo() const { return scanTo_; }
+  const char* divergenceBy() const { return scanByHash_ ? "hash" : "observation"; }
+  /// Runs the scan for about `seconds` of wall time (at least one common tick).
+  void scanWork(double seconds);
   const Observation& observationA() const { return obsA_; }
   const Observation& observationB() const { return obsB_; }
 
@@ -111,8 +120,12 @@ class Playback {
   std::string labelB_;
   bool measured_ = false;
   TickDivergence last_;
-  int64_t firstDivergent_ = -1;
   Observation obsA_, obsB_;
+  // The divergence scan.
+  std::unique_ptr<LockStepReplay> scanA_, scanB_;
+  Observation scanObsA_, scanObsB_;
+  int64_t scanTo_ = -1, scanFirst_ = -1;
+  bool scanDone_ = false, scanByHash_ = false;
 };
 
 }  // namespace sg::viewer

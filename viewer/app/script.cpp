@@ -24,6 +24,15 @@ int scriptKeyCode(const std::string& name) {
   if (n == "backspace") return GLFW_KEY_BACKSPACE;
   if (n == "period" || n == ".") return GLFW_KEY_PERIOD;
   if (n == "home") return GLFW_KEY_HOME;
+  if (n == "comma" || n == ",") return GLFW_KEY_COMMA;
+  if (n == "slash" || n == "/") return GLFW_KEY_SLASH;
+  if (n == "pagedown") return GLFW_KEY_PAGE_DOWN;
+  if (n == "pageup") return GLFW_KEY_PAGE_UP;
+  if (n.size() >= 2 && n.size() <= 3 && n[0] == 'f' && std::isdigit(static_cast<unsigned char>(n[1])) &&
+      (n.size() == 2 || std::isdigit(static_cast<unsigned char>(n[2])))) {
+    const int f = std::stoi(n.substr(1));
+    if (f >= 1 && f <= 12) return GLFW_KEY_F1 + f - 1;
+  }
   return -1;
 }
 
@@ -76,9 +85,31 @@ bool parseScript(const std::string& text, const std::string& file, std::vector<S
       if (w.size() != 3 || (w[2] != "down" && w[2] != "up") || (c.key = scriptKeyCode(w[1])) < 0)
         return fail(
             "expected 'key K down|up' (K: a letter, a digit, tab, space, shift, ctrl, escape, backspace, "
-            "period or home), got '" +
+            "period, comma, slash, home, pagedown, pageup or f1..f12), got '" +
             shown + "'");
       c.down = w[2] == "down";
+    } else if (cmd == "tap") {
+      c.kind = ScriptCommand::Kind::Tap;
+      if (w.size() != 2 || (c.key = scriptKeyCode(w[1])) < 0)
+        return fail("expected 'tap K' (K: a key name as for 'key'), got '" + shown + "'");
+    } else if (cmd == "mouse") {
+      c.kind = ScriptCommand::Kind::Mouse;
+      bool ok = w.size() == 3 && parseFloat(w[1], &c.camera[0]) && parseFloat(w[2], &c.camera[1]);
+      ok = ok && c.camera[0] >= 0 && c.camera[1] >= 0 && c.camera[0] <= 8192 && c.camera[1] <= 8192;
+      if (!ok) return fail("expected 'mouse X Y' (window pixels, 0 to 8192), got '" + shown + "'");
+    } else if (cmd == "button") {
+      c.kind = ScriptCommand::Kind::Button;
+      if (w.size() != 3 || (w[1] != "left" && w[1] != "right") || (w[2] != "down" && w[2] != "up"))
+        return fail("expected 'button left|right down|up', got '" + shown + "'");
+      c.key = w[1] == "left" ? GLFW_MOUSE_BUTTON_LEFT : GLFW_MOUSE_BUTTON_RIGHT;
+      c.down = w[2] == "down";
+    } else if (cmd == "back") {
+      c.kind = ScriptCommand::Kind::Back;
+      if (w.size() != 2 || !parseCount(w[1], 100000000, &c.count))
+        return fail("expected 'back N' (N from 0 to 100000000), got '" + shown + "'");
+    } else if (cmd == "restart") {
+      c.kind = ScriptCommand::Kind::Restart;
+      if (w.size() != 1) return fail("expected 'restart' alone, got '" + shown + "'");
     } else if (cmd == "camera") {
       c.kind = ScriptCommand::Kind::Camera;
       bool ok = w.size() == 6;
@@ -150,8 +181,8 @@ bool parseScript(const std::string& text, const std::string& file, std::vector<S
       c.value.erase(c.value.find_last_not_of(" \t") + 1);
     } else {
       return fail("unknown command '" + shown +
-                  "' (expected frames, key, camera, select, record, screenshot, quit, play, pause, step, seek, "
-                  "speed, ab, open, set, regenerate, lod, print or status)");
+                  "' (expected frames, key, tap, mouse, button, camera, select, record, screenshot, quit, play, "
+                  "pause, step, back, restart, seek, speed, ab, open, set, regenerate, lod, print or status)");
     }
     out->push_back(c);
   }

@@ -1,5 +1,6 @@
 #include "viewer/app/session.h"
 
+#include <algorithm>
 #include <cinttypes>
 #include <cstdio>
 #include <filesystem>
@@ -45,9 +46,9 @@ std::unique_ptr<Session> Session::rebuilt(const std::string& text, bool replayHi
   s->scenarioDir = scenarioDir;
   s->scenario = parseScenario(text, scenario.sourceName, relativeReader(scenarioDir, &s->files));
   s->world = makeWorld(s->scenario, threads, physicalMemoryBytes());
-  if (replayHistory)
-    for (const TickInput& in : history) {
-      const StepResult r = s->step(in);
+  if (replayHistory)  // up to the live tick: inputs beyond it (after a step back) are not taken
+    for (int64_t t = 0; t < world->tick(); ++t) {
+      const StepResult r = s->step(history[size_t(t)]);
       if (!r.ok)
         throw ScenarioError(scenario.sourceName, "$",
                             "a scenario the session so far replays under (" + r.error.message() + ")");
@@ -56,11 +57,22 @@ std::unique_ptr<Session> Session::rebuilt(const std::string& text, bool replayHi
 }
 
 StepResult Session::step(const TickInput& input) {
+  const int64_t now = world->tick();
+  if (now < historyEnd()) {  // a new branch from here: the old future goes, and its snapshots
+    history.resize(size_t(now));
+    while (!snapshots_.empty() && snapshots_.back().first > now) snapshots_.pop_back();
+  }
   history.push_back(input);
-  if (!recorder) return world->step(input, &clock);
+  if (!recorder) {
+    StepResult r = world->step(input, &clock);
+    if (r.ok) keepSnapshot();
+    return r;
+  }
   const int64_t before = world->tick();
   try {
-    return recorder->step(input, &clock);
+    StepResult r = recorder->step(input, &clock);
+    if (r.ok) keepSnapshot();
+    return r;
   } catch (const std::exception& e) {
     // A write that failed (a full disk, a file-size limit): the recording ends at its last
     // complete chunk (still readable, as a recording cut off by a crash) and the session goes on
@@ -73,6 +85,60 @@ StepResult Session::step(const TickInput& input) {
   }
 }
 
+StepResult Session::replayNext() {
+  const int64_t t = world->tick();
+  if (t >= historyEnd()) return {};
+  StepResult r = world->step(history[size_t(t)], &clock);
+  if (r.ok) keepSnapshot();
+  return r;
+}
+
+void Session::keepSnapshot() {
+  const int64_t t = world->tick();
+  if (t % snapshotEvery_ != 0 || (!snapshots_.empty() && snapshots_.back().first >= t)) return;
+  snapshots_.emplace_back(t, world->saveState());
+  // Within the budget: at most 64 states, fewer for big worlds (at least 2); beyond it the spacing
+  // doubles and every state off the new spacing goes.
+  const uint64_t bytes = std::max<uint64_t>(1, snapshots_.back().second.size());
+  const size_t keep = size_t(std::clamp<uint64_t>(kLiveSnapshotBytes / bytes, 2, 64));
+  while (snapshots_.size() > keep) {
+    snapshotEvery_ *= 2;
+    std::erase_if(snapshots_, [&](const auto& s) { return s.first % snapshotEvery_ != 0; });
+  }
+}
+
+bool Session::seek(int64_t t, bool* stopped, std::string* error) {
+  *stopped = false;
+  t = std::clamp<int64_t>(t, 0, historyEnd());
+  if (t == world->tick()) return true;
+  if (recorder) {
+    if (!stopRecording(error)) return false;
+    *stopped = true;
+  }
+  // The nearest kept state at or before t, unless stepping on from here is shorter.
+  const auto snap = std::find_if(snapshots_.rbegin(), snapshots_.rend(), [&](const auto& s) { return s.first <= t; });
+  const int64_t from = snap == snapshots_.rend() ? 0 : snap->first;
+  if (!(world->tick() <= t && world->tick() >= from)) {
+    try {
+      if (snap == snapshots_.rend())
+        world = makeWorld(scenario, threads, physicalMemoryBytes());
+      else
+        world->restoreState(snap->second);
+    } catch (const std::exception& e) {
+      *error = std::string("going back to tick ") + std::to_string(from) + ": " + e.what();
+      return false;
+    }
+  }
+  while (world->tick() < t) {
+    const StepResult r = world->step(history[size_t(world->tick())], &clock);
+    if (!r.ok) {
+      *error = "replaying the session to tick " + std::to_string(t) + " faulted: " + r.error.message();
+      return false;
+    }
+  }
+  return true;
+}
+
 bool Session::startRecording(const std::string& path, std::string* error) {
   if (recorder) {
     *error = "already recording to " + recordPath;
@@ -83,8 +149,11 @@ bool Session::startRecording(const std::string& path, std::string* error) {
     RecordSettings settings;
     settings.checkEvery = defaultCheckEvery(fresh->counts().patches());
     auto rec = std::make_unique<Recorder>(path, scenario, files, *fresh, settings);
-    for (const TickInput& in : history) {
-      const StepResult r = rec->step(in);
+    // The ticks up to the live world's (after a step back, the inputs beyond it are a future the
+    // recording does not take: recording starts a new branch from here).
+    const int64_t now = world->tick();
+    for (int64_t t = 0; t < now; ++t) {
+      const StepResult r = rec->step(history[size_t(t)]);
       if (!r.ok) {
         *error = "catching up the recording faulted: " + r.error.message();
         return false;
@@ -98,6 +167,8 @@ bool Session::startRecording(const std::string& path, std::string* error) {
     world = std::move(fresh);
     recorder = std::move(rec);
     recordPath = path;
+    history.resize(size_t(now));
+    while (!snapshots_.empty() && snapshots_.back().first > now) snapshots_.pop_back();
     return true;
   } catch (const std::exception& e) {
     *error = path + ": " + e.what();

@@ -35,9 +35,27 @@ class Session {
   /// ScenarioError naming the tick.
   std::unique_ptr<Session> rebuilt(const std::string& text, bool replayHistory) const;
 
-  /// One tick (recorded when recording). A recording write that fails stops the recording, sets
-  /// recordingError (one line) and the session goes on.
+  /// One tick with a new input (recorded when recording). Behind the history's end (after a step
+  /// back or a seek), the inputs after this tick are dropped first: the session takes a new
+  /// branch. A recording write that fails stops the recording, sets recordingError (one line)
+  /// and the session goes on.
   StepResult step(const TickInput& input);
+
+  // ---- the live timeline: pause, step back, scrub (docs/viewer.md "Live control") ----
+  /// The ticks the session has inputs for: the world can be anywhere in 0 .. historyEnd().
+  int64_t historyEnd() const { return int64_t(history.size()); }
+  /// One tick forward along the history (the input that was given at this tick), not recorded:
+  /// stepping forward again after stepping back. Requires world->tick() < historyEnd().
+  StepResult replayNext();
+  /// Moves the world to tick t (0 .. historyEnd()) from the nearest kept state at or before it
+  /// and the recorded inputs. A running recording is stopped first (its file ends at the ticks it
+  /// holds: going back would contradict it); *stopped says so. False with *error on a fault.
+  bool seek(int64_t t, bool* stopped, std::string* error);
+  /// States kept for seeking: one every snapshotEvery() ticks, at most kLiveSnapshotBytes in all
+  /// (the spacing doubles when they would exceed it, so a long session keeps ~64 of them).
+  int64_t snapshotEvery() const { return snapshotEvery_; }
+  size_t snapshotCount() const { return snapshots_.size(); }
+  static constexpr uint64_t kLiveSnapshotBytes = uint64_t(256) << 20;
   std::string recordingError;  ///< set by step() when the recording stopped on a write error
 
   /// Records the whole session, from tick 0, to `path`: a fresh world replays the inputs so far
@@ -46,6 +64,11 @@ class Session {
   bool startRecording(const std::string& path, std::string* error);
   /// Writes END and prints "recorded   N ticks to PATH (hash H)".
   bool stopRecording(std::string* error);
+
+ private:
+  void keepSnapshot();
+  std::vector<std::pair<int64_t, std::vector<uint8_t>>> snapshots_;  ///< (tick, state), increasing ticks
+  int64_t snapshotEvery_ = 60;
 };
 
 /// The scenario text with one value replaced: `dotted` is a path such as "field.patchesX" or
