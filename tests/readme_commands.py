@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """ctest ReadmeCommands: every command in README.md's shell blocks runs and must succeed.
 
-  tests/readme_commands.py SOURCE_DIR BUILD_DIR [--list]
+  tests/readme_commands.py SOURCE_DIR BUILD_DIR [--list] [--doc PATH] [--fresh-per-block]
 
 The README cannot rot: each ```sh block is read in order, its variables (`b=...`, `v=...`) kept,
 comments dropped, and every command run by bash in a scratch folder laid out like the repository
@@ -13,7 +13,9 @@ A few commands are made shorter or safer, always by adding options, never by rep
 command (SHORTENED below says which and why). A command succeeds when it exits 0, or the code
 its README comment names ("(exit 1: ...)"). Two are not run here, because they are the test
 command's own phases (NOT_RUN). The viewer's commands run under `xvfb-run -a` for a few frames.
---list prints what would run and exits.
+--list prints what would run and exits. --doc PATH reads another page's shell blocks instead
+(docs/scale-out.md: ctest ScaleOutDocCommands); --fresh-per-block runs each block in a scratch
+folder of its own (a page whose blocks are independent examples).
 """
 import os
 import re
@@ -47,17 +49,19 @@ def shell_blocks(readme):
 
     A command's expected exit code is 0 unless its comment, or a comment-only line right after
     it, says "(exit N" (the README's `diff` of two different runs exits 1, as documented)."""
-    commands, inside = [], False
+    commands, inside, first = [], False, False
     for number, line in enumerate(readme.splitlines(), 1):
         if line.strip().startswith("```"):
             inside = line.strip() == "```sh" and not inside
+            first = inside
             continue
         if not inside:
             continue
         command = strip_comment(line).strip()
         expected = re.search(r"\(exit (\d+)", line[len(strip_comment(line)):])
         if command:
-            commands.append([number, command, int(expected.group(1)) if expected else 0])
+            commands.append([number, command, int(expected.group(1)) if expected else 0, first])
+            first = False
         elif expected and commands:
             commands[-1][2] = int(expected.group(1))
     return commands
@@ -86,6 +90,8 @@ def plan(command, scratch):
     for pattern, extra, why in SHORTENED:
         if not re.search(pattern, command):
             continue
+        if "sweep" in pattern and re.search(r"--(plan|job|merge)\b", command):
+            continue  # a sharded sweep's steps: the plan holds the (already small) settings
         notes.append(why)
         if pattern.startswith(r"bench/ab"):
             run = re.sub(r"-n\s+\d+", "-n 3", run)
@@ -103,11 +109,14 @@ def main():
         print(__doc__.strip().splitlines()[2].strip(), file=sys.stderr)
         return 2
     source, build = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
-    listing = "--list" in sys.argv[3:]
-    with open(os.path.join(source, "README.md"), encoding="utf-8") as f:
+    args = sys.argv[3:]
+    listing = "--list" in args
+    fresh = "--fresh-per-block" in args
+    doc = args[args.index("--doc") + 1] if "--doc" in args else "README.md"
+    with open(os.path.join(source, doc), encoding="utf-8") as f:
         commands = shell_blocks(f.read())
     if not commands:
-        print("README.md: no ```sh block found", file=sys.stderr)
+        print(f"{doc}: no ```sh block found", file=sys.stderr)
         return 1
     with tempfile.TemporaryDirectory(prefix="simgrass-readme-") as tmp:
         root = os.path.join(tmp, "repo")
@@ -120,15 +129,24 @@ def main():
         os.symlink(build, os.path.join(tmp, "base", "build", "release"))
         env = dict(os.environ, TMPDIR=tmp)
         variables, failures, ran = [], 0, 0
-        for number, command, expected in commands:
-            if re.fullmatch(r"[A-Za-z_]\w*=\S+", command):  # b=build/release/replay/simgrass
+        block, base = None, root
+        for number, command, expected, first in commands:
+            if fresh and first and not listing:  # a block of its own: a new scratch folder, linked like the first
+                block = (block or 0) + 1
+                root = os.path.join(tmp, f"block{block}")
+                os.makedirs(os.path.join(root, "build"))
+                for name in ("scenarios", "bench", ".ci", "docs", "README.md"):
+                    os.symlink(os.path.join(source, name), os.path.join(root, name))
+                os.symlink(build, os.path.join(root, "build", "release"))
+            # b=build/release/replay/simgrass, R=$(python3 -c '...'): kept for every later command
+            if re.fullmatch(r"[A-Za-z_]\w*=(\S+|\$\(.*\))", command):
                 variables.append(command)
                 continue
             run, note = plan(command, tmp)
             if run is None:
-                print(f"README.md:{number}: not run here ({note}): {command}")
+                print(f"{doc}:{number}: not run here ({note}): {command}")
                 continue
-            shown = f"README.md:{number}: {command}" + (f"\n    run as: {run}  ({note})" if run != command else "")
+            shown = f"{doc}:{number}: {command}" + (f"\n    run as: {run}  ({note})" if run != command else "")
             if listing:
                 print(shown)
                 continue
@@ -149,7 +167,7 @@ def main():
                 print(f"FAIL {seconds:6.1f} s  {shown}\n    exit {code}, expected {expected}; its output ends:")
                 print("\n".join("    | " + l for l in output.rstrip().splitlines()[-15:]))
         if not listing:
-            print(f"{ran - failures} of {ran} README commands succeeded")
+            print(f"{ran - failures} of {ran} {doc} commands succeeded")
         return 1 if failures else 0
 
 

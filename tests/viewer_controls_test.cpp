@@ -62,7 +62,8 @@ std::vector<std::pair<int64_t, std::string>> printed(const std::string& out) {
 /// The bodies of a recording's state at `tick` (`simgrass replay --to T --export-state x.json`).
 json bodiesAt(const TempDir& dir, const std::string& rec, int64_t tick) {
   const std::string out = dir.file("state-" + std::to_string(tick) + ".json");
-  const CliResult r = runCli("replay " + quote(rec) + " --to " + std::to_string(tick) + " --export-state " + quote(out));
+  const CliResult r =
+      runCli("replay " + quote(rec) + " --to " + std::to_string(tick) + " --export-state " + quote(out));
   EXPECT_EQ(r.exitCode, 0) << r.describe();
   return json::parse(readFile(out), nullptr, false)["bodies"];
 }
@@ -148,15 +149,16 @@ TEST(ViewerControls, TapsShorterThanAFrameAreNotLost) {
   const std::string rec = dir.file("tapped.sgr");
   // R tapped (down and up before the frame): recording starts; T tapped: one frame of drive; R
   // tapped again: the recording stops. With the old polling, none of the three was seen.
-  const std::string script = dir.write("taps.txt", "frames 2\ntap r\nframes 3\nselect 0\ntap t\nframes 3\ntap r\n"
-                                                   "frames 1\ntap f1\nframes 1\nstatus\nquit\n");
-  const CliResult v = runViewer(scenario("thesis-bodies.json") + " --script " + quote(script) + kWindow, true,
-                                dir.file(""));
+  const std::string script = dir.write("taps.txt",
+                                       "frames 2\ntap r\nframes 3\nselect 0\ntap t\nframes 3\ntap r\n"
+                                       "frames 1\ntap f1\nframes 1\nstatus\nquit\n");
+  const CliResult v =
+      runViewer(scenario("thesis-bodies.json") + " --script " + quote(script) + kWindow, true, dir.file(""));
   ASSERT_EQ(v.exitCode, 0) << v.describe();
   const std::vector<std::string> recorded = linesStarting(v.out, "recorded   ");
   ASSERT_EQ(recorded.size(), 1u) << "R tapped twice: one recording, started and stopped\n" << v.describe();
-  const std::string file = recorded[0].substr(recorded[0].find(" to ") + 4, recorded[0].find(" (hash") -
-                                                                              recorded[0].find(" to ") - 4);
+  const std::string file =
+      recorded[0].substr(recorded[0].find(" to ") + 4, recorded[0].find(" (hash") - recorded[0].find(" to ") - 4);
   EXPECT_EQ(recorded[0].rfind("8 ticks", 0), 0u) << recorded[0];
   const CliResult verify = runCli("replay " + quote(dir.file(file)) + " --verify");
   EXPECT_EQ(verify.exitCode, 0) << verify.describe();
@@ -223,12 +225,13 @@ TEST(ViewerControls, FollowKeepsTheCameraOnTheBodyAndF3FreezesTheWindow) {
   TempDir dir;
   // lod-crossing: a 30 m window follows the camera. Frozen (F3), the camera walks 20 m and the
   // window stays; F3 again and it catches up. Then the camera follows body 0 driven along x.
-  const std::string script = dir.write("cam.txt",
-                                       "frames 2\nstatus\ntap f3\nkey shift down\nkey w down\nframes 60\n"
-                                       "key w up\nkey shift up\nstatus\ntap f3\nframes 2\nstatus\n"
-                                       "select 0\ntap l\nframes 1\nstatus\nkey t down\nframes 30\nkey t up\nstatus\nquit\n");
-  const CliResult v = runViewer(scenario("lod-crossing.json") + " --no-scenario-input --script " + quote(script) +
-                                kWindow);
+  const std::string script =
+      dir.write("cam.txt",
+                "frames 2\nstatus\ntap f3\nkey shift down\nkey w down\nframes 60\n"
+                "key w up\nkey shift up\nstatus\ntap f3\nframes 2\nstatus\n"
+                "select 0\ntap l\nframes 1\nstatus\nkey t down\nframes 30\nkey t up\nstatus\nquit\n");
+  const CliResult v =
+      runViewer(scenario("lod-crossing.json") + " --no-scenario-input --script " + quote(script) + kWindow);
   ASSERT_EQ(v.exitCode, 0) << v.describe();
   const auto window = linesStarting(v.out, "window     ");
   const auto camera = linesStarting(v.out, "camera     ");
@@ -255,12 +258,12 @@ TEST(ViewerControls, ScreenshotKeyHelpAndHiddenPanelsShowInTheWindow) {
   if (!onPath("xvfb-run")) GTEST_SKIP() << "xvfb-run is not on PATH";
   TempDir dir;
   const std::string config = dir.file("config");
-  const std::string script = dir.write("ui.txt",
-                                       "frames 1\nscreenshot " + dir.file("panels.png") + "\ntap f2\nframes 1\n" +
-                                           "screenshot " + dir.file("hidden.png") + "\ntap f1\nframes 1\n" +
-                                           "screenshot " + dir.file("help.png") + "\ntap f1\ntap f12\nframes 1\nquit\n");
-  const CliResult v = runViewer(" --script " + quote(script) + " --config-dir " + quote(config) + kWindow, true,
-                                dir.file(""));
+  const std::string script =
+      dir.write("ui.txt", "frames 1\nscreenshot " + dir.file("panels.png") + "\ntap f2\nframes 1\n" + "screenshot " +
+                              dir.file("hidden.png") + "\ntap f1\nframes 1\n" + "screenshot " + dir.file("help.png") +
+                              "\ntap f1\ntap f12\nframes 1\nquit\n");
+  const CliResult v =
+      runViewer(" --script " + quote(script) + " --config-dir " + quote(config) + kWindow, true, dir.file(""));
   ASSERT_EQ(v.exitCode, 0) << v.describe();
   const std::string panels = readFile(dir.file("panels.png")), hidden = readFile(dir.file("hidden.png")),
                     help = readFile(dir.file("help.png"));
@@ -291,9 +294,10 @@ TEST(ViewerControls, PageDownOpensTheNextScenarioOfTheFolder) {
   fs::copy_file(test::sourcePath("scenarios/thesis-meadow.json"), dir.file("b.json"));
   fs::copy_file(test::sourcePath("scenarios/thesis-meadow.json"), dir.file("c.json"));
   const std::string script =
-      dir.write("scenes.txt", "tap pageup\ntap pagedown\ntap pagedown\nframes 1\nstatus\ntap pagedown\nframes 1\n"
-                              "status\ntap pageup\n"
-                              "tap pageup\nframes 1\nstatus\nquit\n");
+      dir.write("scenes.txt",
+                "tap pageup\ntap pagedown\ntap pagedown\nframes 1\nstatus\ntap pagedown\nframes 1\n"
+                "status\ntap pageup\n"
+                "tap pageup\nframes 1\nstatus\nquit\n");
   const CliResult v = runViewer(quote(dir.file("a.json")) + " --script " + quote(script) + kWindow);
   ASSERT_EQ(v.exitCode, 0) << v.describe();
   const auto status = linesStarting(v.out, "status     ");
@@ -309,7 +313,8 @@ TEST(ViewerControls, AbSideBySideHasADividerAndLabelsAndThePanelsBesideTheViews)
   const std::string rec = test::sourcePath("scenarios/recordings/thesis-bodies-fx32.sgr");
   const std::string shot = dir.file("ab.png");
   const std::string script = dir.write("ab.txt", "step 3\nframes 1\nscreenshot " + shot + "\nquit\n");
-  const CliResult v = runViewer(quote(rec) + " --ab-variant interp=2 --script " + quote(script) + " --size 600x240 --msaa 0");
+  const CliResult v =
+      runViewer(quote(rec) + " --ab-variant interp=2 --script " + quote(script) + " --size 600x240 --msaa 0");
   ASSERT_EQ(v.exitCode, 0) << v.describe();
   int width = 0, height = 0, channels = 0;
   unsigned char* data = stbi_load(shot.c_str(), &width, &height, &channels, 4);
@@ -337,8 +342,8 @@ TEST(ViewerControls, AbSideBySideHasADividerAndLabelsAndThePanelsBesideTheViews)
 
 TEST(ViewerControls, BadControlLinesAreOneLineAndExit2) {
   TempDir dir;
-  for (const char* line : {"mouse -1 0", "mouse 1", "button middle down", "button left sideways", "tap nokey",
-                           "back x", "restart now", "key f13 down", "tap f0"}) {
+  for (const char* line : {"mouse -1 0", "mouse 1", "button middle down", "button left sideways", "tap nokey", "back x",
+                           "restart now", "key f13 down", "tap f0"}) {
     const std::string script = dir.write("bad.txt", std::string(line) + "\n");
     const CliResult v = runViewer("--script " + quote(script), false);
     EXPECT_EQ(v.exitCode, 2) << line << "\n" << v.describe();
