@@ -1,7 +1,8 @@
 #include "replay/cli/sweep_shards.h"
 
+#include "replay/cli/sweep_shard_format.h"
+
 #include <xxhash.h>
-#include <zstd.h>
 
 #include <algorithm>
 #include <cinttypes>
@@ -28,9 +29,7 @@ using nlohmann::json;
 
 constexpr const char* kPlanFormat = "simgrass-sweep-plan/1";
 constexpr const char* kShardFormat = "simgrass-sweep-shard/1";
-constexpr char kShardMagic[8] = {'S', 'G', 'S', 'W', 'E', 'E', 'P', '1'};
 constexpr uint64_t kPlanBytes = uint64_t(16) << 20;
-constexpr uint64_t kShardJsonBytes = uint64_t(64) << 20;
 constexpr const char* kPlanCopy = "plan.json";
 
 std::string hex64(uint64_t v) {
@@ -52,9 +51,16 @@ double fromBits(uint64_t u) {
 }
 
 json optionsJson(const Options& o) {
-  return {{"scenarios", o.scenarios}, {"scalars", o.scalars}, {"k", o.ks},          {"dt", o.dts},
-          {"lod", o.lods},             {"broadphase", o.broadphases}, {"models", o.models},
-          {"seconds", o.seconds},      {"repeats", o.repeats},        {"threads", o.threads}};
+  return {{"scenarios", o.scenarios},
+          {"scalars", o.scalars},
+          {"k", o.ks},
+          {"dt", o.dts},
+          {"lod", o.lods},
+          {"broadphase", o.broadphases},
+          {"models", o.models},
+          {"seconds", o.seconds},
+          {"repeats", o.repeats},
+          {"threads", o.threads}};
 }
 
 /// A one-line error about `file`: "file: where: expected what".
@@ -100,146 +106,12 @@ Options optionsFrom(const json& j, const std::string& file) {
 
 // ---- bytes ----------------------------------------------------------------------------------
 
-void put64(std::vector<uint8_t>& out, uint64_t v) {
-  const size_t at = out.size();
-  out.resize(at + 8);
-  storeLE<uint64_t>(out.data() + at, v);
-}
-void putDoubles(std::vector<uint8_t>& out, const std::vector<double>& v) {
-  put64(out, v.size());
-  const size_t at = out.size();
-  out.resize(at + 8 * v.size());
-  for (size_t i = 0; i < v.size(); ++i) storeLE<double>(out.data() + at + 8 * i, v[i]);
-}
-
-/// Reads a payload back, every length checked against what is left (a damaged shard is an
-/// error at its offset, never an allocation it cannot back).
-struct Reader {
-  const std::vector<uint8_t>& bytes;
-  size_t at = 0;
-  const std::string& file;
-  uint64_t u64(const char* what) {
-    if (bytes.size() - at < 8) fail(file, "payload byte " + std::to_string(at), what);
-    const uint64_t v = loadLE<uint64_t>(bytes.data() + at);
-    at += 8;
-    return v;
-  }
-  std::vector<double> doubles(const char* what) {
-    const uint64_t n = u64(what);
-    if (n > (bytes.size() - at) / 8) fail(file, "payload byte " + std::to_string(at - 8), what);
-    std::vector<double> v(n);
-    for (size_t i = 0; i < n; ++i) v[i] = loadLE<double>(bytes.data() + at + 8 * i);
-    at += 8 * n;
-    return v;
-  }
-};
-
-/// The reference shard's payload: the reference recording's bytes and the observations.
-std::vector<uint8_t> referencePayload(const ScenarioRun& sc) {
-  std::vector<uint8_t> raw;
-  put64(raw, sc.recording->bytes.size());
-  raw.insert(raw.end(), sc.recording->bytes.begin(), sc.recording->bytes.end());
-  put64(raw, sc.observed.size());
-  for (const Observation& o : sc.observed) {
-    put64(raw, uint64_t(o.tick));
-    put64(raw, uint64_t(o.patchesX));
-    put64(raw, uint64_t(o.patchesZ));
-    put64(raw, uint64_t(o.contacts));
-    putDoubles(raw, o.tipX);
-    putDoubles(raw, o.tipY);
-    putDoubles(raw, o.tipZ);
-    putDoubles(raw, o.bodyPosition);
-    putDoubles(raw, o.bodyOrientation);
-  }
-  return raw;
-}
-
-void readReferencePayload(const std::vector<uint8_t>& raw, const std::string& file, ScenarioRun& sc) {
-  Reader r{raw, 0, file};
-  const uint64_t n = r.u64("the reference recording's size");
-  if (n > raw.size() - r.at) fail(file, "payload byte 0", "a reference recording within the shard");
-  std::vector<uint8_t> recording(raw.begin() + std::ptrdiff_t(r.at), raw.begin() + std::ptrdiff_t(r.at + n));
-  r.at += n;
-  try {
-    sc.recording = std::make_unique<sgr::Recording>(sgr::parseRecording(std::move(recording), file));
-  } catch (const sgr::RecordingError& e) {
-    fail(file, "payload", std::string("an intact reference recording (") + e.what() + ")");
-  }
-  const uint64_t count = r.u64("the observation count");
-  if (count > raw.size() / 40) fail(file, "payload", "an observation count that fits the shard");
-  sc.observed.clear();
-  for (uint64_t k = 0; k < count; ++k) {
-    Observation o;
-    o.tick = int64_t(r.u64("an observation's tick"));
-    o.patchesX = int64_t(r.u64("its patches"));
-    o.patchesZ = int64_t(r.u64("its patches"));
-    o.contacts = int64_t(r.u64("its contacts"));
-    o.tipX = r.doubles("its tips");
-    o.tipY = r.doubles("its tips");
-    o.tipZ = r.doubles("its tips");
-    o.bodyPosition = r.doubles("its body positions");
-    o.bodyOrientation = r.doubles("its body orientations");
-    sc.observed.push_back(std::move(o));
-  }
-  if (r.at != raw.size()) fail(file, "payload byte " + std::to_string(r.at), "the end of the payload");
-}
-
-/// Shard bytes: magic, u32 JSON length, the JSON header, u64 payload length, the payload (zstd),
-/// u64 xxHash3 of everything before it. Little-endian.
-std::vector<uint8_t> shardBytes(const json& header, const std::vector<uint8_t>& payload) {
-  const std::string text = header.dump();
-  std::vector<uint8_t> packed;
-  if (!payload.empty()) {
-    packed.resize(ZSTD_compressBound(payload.size()));
-    const size_t n = ZSTD_compress(packed.data(), packed.size(), payload.data(), payload.size(), 3);
-    if (ZSTD_isError(n)) throw std::runtime_error(std::string("zstd: ") + ZSTD_getErrorName(n));
-    packed.resize(n);
-  }
-  std::vector<uint8_t> out(kShardMagic, kShardMagic + 8);
-  out.resize(12);
-  storeLE<uint32_t>(out.data() + 8, uint32_t(text.size()));
-  out.insert(out.end(), text.begin(), text.end());
-  put64(out, packed.size());
-  out.insert(out.end(), packed.begin(), packed.end());
-  put64(out, XXH3_64bits(out.data(), out.size()));
-  return out;
-}
-
-struct Shard {
-  json header;
-  std::vector<uint8_t> payload;  ///< decompressed
-};
-
 /// Reads and checks a shard file. Throws std::runtime_error ("file: byte N: expected ...").
 Shard readShard(const std::string& path, uint64_t maxPayload, bool withPayload = true) {
   std::vector<uint8_t> b;
   std::string expected;
   if (!readInputFile(path, InputLimits::kRecordingBytes, &b, &expected)) fail(path, "byte 0", expected);
-  if (b.size() < 8 || std::memcmp(b.data(), kShardMagic, 8) != 0)
-    fail(path, "byte 0", "a sweep shard (SGSWEEP1)");
-  if (b.size() < 12 + 8 + 8) fail(path, "byte 8", "a complete shard (it is cut off)");
-  const uint64_t sum = loadLE<uint64_t>(b.data() + b.size() - 8);
-  if (XXH3_64bits(b.data(), b.size() - 8) != sum)
-    fail(path, "byte " + std::to_string(b.size() - 8), "the shard's checksum (the file is damaged)");
-  const uint32_t textBytes = loadLE<uint32_t>(b.data() + 8);
-  if (textBytes > kShardJsonBytes || 12 + uint64_t(textBytes) + 16 > b.size())
-    fail(path, "byte 8", "a header length within the shard");
-  Shard s;
-  s.header = json::parse(b.begin() + 12, b.begin() + 12 + textBytes, nullptr, false);
-  if (!s.header.is_object()) fail(path, "byte 12", "a JSON header");
-  const size_t at = 12 + textBytes;
-  const uint64_t packed = loadLE<uint64_t>(b.data() + at);
-  if (packed != b.size() - at - 16) fail(path, "byte " + std::to_string(at), "a payload length within the shard");
-  if (packed > 0 && withPayload) {
-    const uint8_t* src = b.data() + at + 8;
-    const unsigned long long size = ZSTD_getFrameContentSize(src, packed);
-    if (size == ZSTD_CONTENTSIZE_ERROR || size == ZSTD_CONTENTSIZE_UNKNOWN || size > maxPayload)
-      fail(path, "byte " + std::to_string(at + 8), "a zstd payload of a known size within the plan's bounds");
-    s.payload.resize(size);
-    const size_t n = ZSTD_decompress(s.payload.data(), s.payload.size(), src, packed);
-    if (ZSTD_isError(n) || n != size) fail(path, "byte " + std::to_string(at + 8), "an intact zstd payload");
-  }
-  return s;
+  return parseShard(b, path, maxPayload, withPayload);
 }
 
 /// The most a reference payload of this plan can hold (a damaged size field cannot ask for more).
@@ -308,12 +180,13 @@ void takeReference(Plan& plan, size_t s, const Shard& shard, const std::string& 
   }
   for (Row& r : plan.rows)
     if (r.scenario == s) r.modelError = sc.modelError.at(r.settings.timeStep->toString());
-  if (withObservations) readReferencePayload(shard.payload, file, sc);
+  if (withObservations) readReferencePayload(shard.payload, file, &sc.recording, &sc.observed);
 }
 
 /// Checks that a shard belongs to this plan and is the job its header says; returns the job.
 int64_t shardJob(const Plan& plan, const std::string& fingerprint, const Shard& s, const std::string& file) {
-  if (s.header.value("format", std::string()) != kShardFormat) fail(file, "$.format", std::string("'") + kShardFormat + "'");
+  if (s.header.value("format", std::string()) != kShardFormat)
+    fail(file, "$.format", std::string("'") + kShardFormat + "'");
   const std::string theirs = s.header.value("fingerprint", std::string());
   if (theirs != fingerprint)
     fail(file, "$.fingerprint",
@@ -323,8 +196,8 @@ int64_t shardJob(const Plan& plan, const std::string& fingerprint, const Shard& 
     fail(file, "$.job", "a job from 0 to " + std::to_string(jobCount(plan) - 1) + ", got " + std::to_string(job));
   const std::string kind = field<std::string>(s.header, "kind", file, "$");
   if (kind != (job < referenceJobs(plan) ? "reference" : "variant"))
-    fail(file, "$.kind", std::string(job < referenceJobs(plan) ? "reference" : "variant") + " for job " +
-                             std::to_string(job));
+    fail(file, "$.kind",
+         std::string(job < referenceJobs(plan) ? "reference" : "variant") + " for job " + std::to_string(job));
   return job;
 }
 }  // namespace
@@ -486,19 +359,17 @@ int runJob(Plan& plan, const std::string& fingerprint, int64_t job, const std::s
                            {"settleAfterPress", bitsOf(sc.behaviour.settleAfterPress)},
                            {"downAfterPress", bitsOf(sc.behaviour.downAfterPress)}};
     header["modelError"] = std::move(errors);
-    payload = referencePayload(sc);
+    payload = referencePayload(*sc.recording, sc.observed);
   } else {
     Row& row = plan.rows[size_t(job - referenceJobs(plan))];
     const int64_t refJob = int64_t(row.scenario);
     try {  // the reference of its scenario, from its shard: computed once, by its own job
       const std::string refFile = shardPath(dir, refJob);
       const Shard ref = readShard(refFile, maxPayloadBytes(plan));
-      if (shardJob(plan, fingerprint, ref, refFile) != refJob)
-        fail(refFile, "$.job", "job " + std::to_string(refJob));
+      if (shardJob(plan, fingerprint, ref, refFile) != refJob) fail(refFile, "$.job", "job " + std::to_string(refJob));
       takeReference(plan, row.scenario, ref, refFile, true);
     } catch (const std::exception& e) {
-      printError("simgrass sweep: job %" PRId64 " needs the reference shard of job %" PRId64
-                 " (run it first): %s\n",
+      printError("simgrass sweep: job %" PRId64 " needs the reference shard of job %" PRId64 " (run it first): %s\n",
                  job, refJob, e.what());
       return kExitBadInput;
     }
@@ -528,7 +399,8 @@ int runJob(Plan& plan, const std::string& fingerprint, int64_t job, const std::s
     return kExitMismatch;
   }
   if (!fs::exists(planCopy, ec) && !writePlan(plan, planCopy)) return kExitMismatch;
-  if (!quiet) std::printf("job %" PRId64 " (%s): wrote %s\n", job, jobName(plan, job).c_str(), shardPath(dir, job).c_str());
+  if (!quiet)
+    std::printf("job %" PRId64 " (%s): wrote %s\n", job, jobName(plan, job).c_str(), shardPath(dir, job).c_str());
   return kExitOk;
 }
 
