@@ -30,7 +30,8 @@ class SweepScaleOut : public testing::Test {
  "wind": {"schedule": [{"force": [0, 1, 0.9], "duration": 0.2}, {"force": [0, 0, 0], "duration": 0.2}]},
  "bodies": {"list": [{"name": "ball", "shape": {"type": "sphere", "radius": 0.3}, "mass": 0.45, "position": [-2, 0.3, 0]}]},
  "script": [{"tick": 2, "body": "ball", "command": "addVelocity", "value": [3, 0, 0]}]})");
-    const std::string b = dir_->write("b.json", R"({"format": "simgrass-scenario/1", "name": "plain", "timeStep": "1/60",
+    const std::string b =
+        dir_->write("b.json", R"({"format": "simgrass-scenario/1", "name": "plain", "timeStep": "1/60",
  "field": {"patchesX": 21, "patchesZ": 21, "spacing": 0.25}})");
     settings_ = "--scenarios " + quote(a) + "," + quote(b) +
                 " --seconds 0.2 --repeats 1 --scalars fx32,fx16 --k 1,2 --dt 1/60 --lod off";
@@ -61,8 +62,8 @@ class SweepScaleOut : public testing::Test {
 
 /// The columns that do not depend on where a job ran (every column but the costs and the flags
 /// drawn from them).
-const std::vector<std::string> kCostColumns = {"ms_per_tick", "ms_per_simulated_second", "pareto", "pareto_tip_max",
-                                               "pareto_body", "pareto_model"};
+const std::vector<std::string> kCostColumns = {
+    "ms_per_tick", "ms_per_simulated_second", "pareto", "pareto_tip_max", "pareto_body", "pareto_model"};
 
 void expectSameNumbers(const json& single, const json& merged) {
   ASSERT_EQ(single["rows"].size(), merged["rows"].size());
@@ -176,6 +177,42 @@ TEST_F(SweepScaleOut, MergeRefusesMissingDuplicateForeignAndDamagedShards) {
   EXPECT_NE(changed.err.find("a scenario or a file it reads changed since"), std::string::npos) << changed.err;
 }
 
+TEST_F(SweepScaleOut, ADamagedPlanIsOneLineNamingItsJsonPath) {
+  const json good = json::parse(readFile(file("plan.json")));
+  auto refused = [&](const std::string& text, const std::string& expected) {
+    const std::string bad = dir_->write("bad-plan.json", text);
+    const CliResult r = runCli("sweep --plan " + quote(bad) + " --job 0 --out " + quote(file("s")));
+    EXPECT_EQ(r.exitCode, 2) << r.describe();
+    EXPECT_TRUE(isOneLine(r.err)) << r.describe();
+    EXPECT_NE(r.err.find(expected), std::string::npos) << "expected '" << expected << "' in\n" << r.err;
+  };
+  refused("not json", "bad-plan.json: $: expected a sweep plan");
+  json j = good;
+  j["format"] = "simgrass-sweep-plan/9";
+  refused(j.dump(), "$.format: expected 'simgrass-sweep-plan/1'");
+  j = good;
+  j["build"] = "simgrass 0.0.1 other";
+  refused(j.dump(), "$.build: expected a plan of this build");
+  j = good;
+  j["options"].erase("seconds");
+  refused(j.dump(), "$.options.seconds: expected a value (missing)");
+  j = good;
+  j["options"]["repeats"] = "3";
+  refused(j.dump(), "$.options.repeats: expected an integer");
+  j = good;
+  j["options"]["repeats"] = 100000;
+  refused(j.dump(), "$.options.repeats: expected 1 to 100");
+  j = good;
+  j["options"]["k"] = "1,9";
+  refused(j.dump(), "$.options: --k: expected a comma-separated list of 1, 2, 3, 4, got '9'");
+  j = good;
+  j["fingerprint"] = "0000000000000000";
+  refused(j.dump(), "$.fingerprint: expected the inputs the plan was made from");
+  const CliResult missing = runCli("sweep --merge " + quote(file("nothing")) + " --out " + quote(file("o")));
+  EXPECT_EQ(missing.exitCode, 2);
+  EXPECT_NE(missing.err.find("nothing/plan.json: $: expected"), std::string::npos) << missing.err;
+}
+
 TEST_F(SweepScaleOut, AJobRunAgainReplacesItsShardAndChangesNoNumber) {
   runJobs(0, jobs_, "shards");
   const CliResult first = merge("shards", "first");
@@ -194,9 +231,9 @@ TEST_F(SweepScaleOut, TheSchedulersIndexesAndTheDocsScriptsAsWritten) {
   // --job env: Slurm's, Kubernetes' and GNU parallel's variables (PARALLEL_SEQ counts from 1).
   const std::string plan = quote(file("plan.json"));
   auto envJob = [&](const std::string& var, const std::string& value, const std::string& extra = "") {
-    const std::string cmd = "env -u SLURM_ARRAY_TASK_ID -u JOB_COMPLETION_INDEX -u PARALLEL_SEQ " + var + "=" +
-                            value + " " + quote(SIMGRASS_CLI) + " sweep --plan " + plan + " --job env " + extra +
-                            " --out " + quote(file("env")) + " --json";
+    const std::string cmd = "env -u SLURM_ARRAY_TASK_ID -u JOB_COMPLETION_INDEX -u PARALLEL_SEQ " + var + "=" + value +
+                            " " + quote(SIMGRASS_CLI) + " sweep --plan " + plan + " --job env " + extra + " --out " +
+                            quote(file("env")) + " --json";
     const int status = std::system(("timeout 60 " + cmd + " >/dev/null 2>" + quote(file("env.err"))).c_str());
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   };

@@ -162,7 +162,9 @@ std::vector<std::string> plotBases(const Plan& plan) {
   std::vector<std::string> plotBase;
   for (size_t s = 0; s < plan.scenarios.size(); ++s) {
     std::string base = slug(plan.scenarios[s].name);
-    if (std::find(plotBase.begin(), plotBase.end(), base) != plotBase.end()) base += "-" + std::to_string(s + 1);
+    // Appended (GCC 12's -Wrestrict misfires on `base += "-" + ...`, bug 105329).
+    if (std::find(plotBase.begin(), plotBase.end(), base) != plotBase.end())
+      base.append("-").append(std::to_string(s + 1));
     plotBase.push_back(base);
   }
   return plotBase;
@@ -272,14 +274,11 @@ int writeReport(const Plan& plan, const std::string& out, bool json) {
       bool Row::*front;
     };
     const Kind kinds[] = {
-        {kPlotSuffixes[0], "tip RMS error", "m", [](const Row& r) { return r.summary.tipRms(); },
-         &Row::pareto},
-        {kPlotSuffixes[1], "tip max error", "m", [](const Row& r) { return r.summary.tipMax; },
-         &Row::paretoTipMax},
+        {kPlotSuffixes[0], "tip RMS error", "m", [](const Row& r) { return r.summary.tipRms(); }, &Row::pareto},
+        {kPlotSuffixes[1], "tip max error", "m", [](const Row& r) { return r.summary.tipMax; }, &Row::paretoTipMax},
         {kPlotSuffixes[2], "body position max error", "m", [](const Row& r) { return r.summary.bodyPosMax; },
          &Row::paretoBody},
-        {kPlotSuffixes[3], "model error", "m", [](const Row& r) { return r.modelError.tipRms; },
-         &Row::paretoModel},
+        {kPlotSuffixes[3], "model error", "m", [](const Row& r) { return r.modelError.tipRms; }, &Row::paretoModel},
     };
     for (const Kind& k : kinds) {
       const std::string path = (fs::path(o.out) / (base + "-" + k.suffix + ".png")).string();
