@@ -132,7 +132,6 @@ VariantSettings referenceSettings() {
   return r;
 }
 
-
 std::string Row::label() const {
   return std::string(scalarName(*settings.scalar)) + " k" + std::to_string(*settings.interpolation) + " " +
          settings.timeStep->toString() + (*settings.lod == LodMode::Window ? " win" : "") +

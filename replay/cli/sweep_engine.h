@@ -56,7 +56,7 @@ VariantSettings referenceSettings();
 struct ScenarioRun {
   std::string file, name;  ///< name: the scenario's, plus " [model]" when --models chose the model
   GrassModel model = GrassModel::Thesis;
-  Scenario own;          ///< as loaded (its own settings, under the chosen model)
+  Scenario own;              ///< as loaded (its own settings, under the chosen model)
   ModelBehaviour behaviour;  ///< one tuft of the scenario under its model (report/model_behaviour.h)
   /// The model's error against the reference blade (report/reference_blade.h) at each swept dt
   /// (by its text; NaN where the one tuft does not validate at that step).

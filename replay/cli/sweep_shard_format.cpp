@@ -126,8 +126,7 @@ std::vector<uint8_t> shardBytes(const nlohmann::json& header, const std::vector<
 }
 
 Shard parseShard(const std::vector<uint8_t>& b, const std::string& path, uint64_t maxPayload, bool withPayload) {
-  if (b.size() < 8 || std::memcmp(b.data(), kShardMagic, 8) != 0)
-    fail(path, "byte 0", "a sweep shard (SGSWEEP1)");
+  if (b.size() < 8 || std::memcmp(b.data(), kShardMagic, 8) != 0) fail(path, "byte 0", "a sweep shard (SGSWEEP1)");
   if (b.size() < 12 + 8 + 8) fail(path, "byte 8", "a complete shard (it is cut off)");
   const uint64_t sum = loadLE<uint64_t>(b.data() + b.size() - 8);
   if (XXH3_64bits(b.data(), b.size() - 8) != sum)
@@ -152,6 +151,5 @@ Shard parseShard(const std::vector<uint8_t>& b, const std::string& path, uint64_
   }
   return s;
 }
-
 
 }  // namespace sg::sweep
