@@ -1,15 +1,21 @@
 // Renderer features (docs/rendering.md): SSAO, the rock blend, OBJ meshes, the debug overlay, the
-// divergence heat map and display interpolation; `simgrass render`'s flags for them. Rendered
+// divergence heat map and display interpolation; culling, crossed tufts on the terrain, body
+// trails, the meadow's colour variation and the edge ring's rows; `simgrass render`'s flags. Rendered
 // offscreen with OSMesa like tests/render_test.cpp; every check compares two renders that differ
 // in one option, or compares against independently computed geometry (projections, ray casts,
 // analytic midpoints), never against hard-coded pixel values.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <memory>
+#include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "sim/world/world.h"
 #include "tests/cli_support.h"
@@ -356,7 +362,7 @@ TEST(RenderSsao, TuftGapsShowOccludedGroundNotAQuad) {
   Scene roof = ground;
   viewer::TuftInstance t{};
   t.x = 0, t.y = 0.10f, t.z = 0;
-  t.halfWidth = 1.0f;
+  t.halfWidth = 1.0f / offscreen().renderer().lighting().crossWidth;  // a quad 2 m wide
   t.topY = 0.11f;
   t.tipX = 0, t.tipZ = 2.0f;
   t.angle = 0;
@@ -677,6 +683,524 @@ TEST(RenderInterpolate, DifferentLayoutsTakeTheCurrentTufts) {
   viewer::interpolateScene(prev, more, 0.5f, &out);
   EXPECT_EQ(out.bodyParts[0].model, more.bodyParts[0].model);
   EXPECT_NEAR(out.tufts[0].topY, 1.5f, 1e-6f) << "the tufts still match";
+}
+
+// ---- issue 18: culling, crossed tufts, terrain, trails, colour, edge ring, SSAO ------------------
+
+// Looking from the meadow's centre along +x, 10 degrees down: half of it is behind the camera.
+// The culled frame must be bit-identical to the unculled one (a culled tuft has no fragment), and
+// every tuft whose root projects into the frame must have been drawn.
+TEST(RenderCull, OffscreenTuftsAreSkippedAndTheFrameIsUnchanged) {
+  const Loaded l = load("thesis-meadow.json", 30);
+  Scene scene;
+  viewer::extractScene(*l.world, l.scenario, &scene);
+  Camera camera;
+  camera.x = 0, camera.y = 1.7f, camera.z = 0, camera.yawDegrees = 90, camera.pitchDegrees = -10;
+  viewer::OffscreenRenderer& r = offscreen();
+  const viewer::RenderOptions saved = r.options();
+  double culledMs = 0, allMs = 0;
+  r.options().cull = true;
+  const Image culled = r.render(scene, camera, &culledMs);
+  const viewer::FrameStats stats = r.renderer().lastFrameStats();
+  r.options().cull = false;
+  const Image all = r.render(scene, camera, &allMs);
+  const viewer::FrameStats unculled = r.renderer().lastFrameStats();
+  r.options() = saved;
+  EXPECT_EQ(differingFraction(culled, all, 0), 0.0) << "culling must not change a pixel";
+  EXPECT_EQ(unculled.drawn, scene.tufts.size());
+  EXPECT_EQ(stats.tufts, scene.tufts.size());
+  EXPECT_EQ(stats.drawn + stats.frustumCulled + stats.distanceCulled, stats.tufts);
+  EXPECT_EQ(stats.distanceCulled, size_t(0)) << "the whole meadow lies within the fog distance";
+  size_t inFrame = 0;
+  for (const viewer::TuftInstance& t : scene.tufts) {
+    int px, py;
+    inFrame += project(camera, t.x, t.y, t.z, &px, &py) ? 1 : 0;
+  }
+  EXPECT_GE(stats.drawn, inFrame) << "every tuft rooted in the frame is drawn";
+  EXPECT_LT(stats.drawn, scene.tufts.size() * 6 / 10) << "the half behind the camera and the sides are culled";
+  std::printf(
+      "cull: %zu of %zu tufts drawn (%zu frustum-culled); frame %.1f ms (cull+sort+upload %.2f ms), "
+      "unculled %.1f ms (%.2f ms); 320x240 4x MSAA, one frame each\n",
+      stats.drawn, stats.tufts, stats.frustumCulled, culledMs, stats.cullAndSortMs, allMs, unculled.cullAndSortMs);
+}
+
+// Tufts past the fog distance (where the fog leaves under 1/255 of their colour) are not drawn.
+TEST(RenderCull, TuftsBeyondTheFogDistanceAreNotDrawn) {
+  viewer::OffscreenRenderer& r = offscreen();
+  const float d = r.renderer().cullDistance();
+  const float density = r.renderer().lighting().fogDensity;
+  EXPECT_LE(std::exp(-(d * density) * (d * density)), 1.0f / 255.0f + 1e-6f);
+  EXPECT_GT(d, 300.0f);
+  Scene scene;  // a line of tufts straight ahead, 50 m to 1 km
+  for (int k = 0; k < 20; ++k) {
+    viewer::TuftInstance t{};
+    t.z = 50.0f * float(k + 1);
+    t.halfWidth = 0.5f;
+    t.topY = 1.0f;
+    scene.tufts.push_back(t);
+  }
+  scene.simulatedTufts = scene.tufts.size();
+  Camera camera;
+  camera.y = 1.0f;
+  renderWith(scene, camera, {});
+  const viewer::FrameStats stats = r.renderer().lastFrameStats();
+  size_t beyond = 0;
+  for (const viewer::TuftInstance& t : scene.tufts) beyond += t.z - 1.5f > d ? 1 : 0;
+  EXPECT_EQ(stats.distanceCulled, beyond);
+  EXPECT_EQ(stats.drawn, scene.tufts.size() - beyond);
+  EXPECT_GT(beyond, size_t(10));
+}
+
+/// Corner c (0 bottom-left, 1 bottom-right, 2 top-left, 3 top-right) of quad q of tuft k.
+std::array<float, 3> corner(const std::vector<std::array<float, 3>>& v, size_t k, int q, int c) {
+  return v[k * 8 + size_t(q) * 4 + size_t(c)];
+}
+
+// Both quads of a tuft: bottom edges through the root, 2 x halfWidth x crossWidth long, at right
+// angles; the top corners the bottom ones raised by the tuft's height and shifted by its tip
+// offset.
+TEST(RenderTufts, CrossedQuadsStandAtRightAnglesAndBothBend) {
+  Scene scene;
+  const float angles[3] = {0.0f, 0.7f, 2.5f};
+  for (int k = 0; k < 3; ++k) {
+    viewer::TuftInstance t{};
+    t.x = float(k), t.y = 0.2f, t.z = -1.0f;
+    t.halfWidth = 0.5f;
+    t.topY = 0.8f;
+    t.tipX = 0.1f * float(k + 1), t.tipZ = -0.15f;
+    t.angle = angles[k];
+    scene.tufts.push_back(t);
+  }
+  const auto v = offscreen().renderer().captureTuftCorners(scene);
+  const float crossWidth = offscreen().renderer().lighting().crossWidth;
+  ASSERT_EQ(v.size(), scene.tufts.size() * 8);
+  for (size_t k = 0; k < scene.tufts.size(); ++k) {
+    const viewer::TuftInstance& t = scene.tufts[k];
+    float dir[2][2];
+    for (int q = 0; q < 2; ++q) {
+      const auto bl = corner(v, k, q, 0), br = corner(v, k, q, 1), tl = corner(v, k, q, 2), tr = corner(v, k, q, 3);
+      EXPECT_NEAR(0.5f * (bl[0] + br[0]), t.x, 1e-5f);
+      EXPECT_NEAR(0.5f * (bl[2] + br[2]), t.z, 1e-5f);
+      EXPECT_NEAR(bl[1], t.y, 1e-5f);
+      EXPECT_NEAR(std::hypot(br[0] - bl[0], br[2] - bl[2]), 2 * t.halfWidth * crossWidth, 1e-5f);
+      dir[q][0] = br[0] - bl[0], dir[q][1] = br[2] - bl[2];
+      for (const auto& [b, top] : {std::pair{bl, tl}, std::pair{br, tr}}) {
+        EXPECT_NEAR(top[0] - b[0], t.tipX, 1e-5f) << "tuft " << k << " quad " << q;
+        EXPECT_NEAR(top[2] - b[2], t.tipZ, 1e-5f) << "tuft " << k << " quad " << q;
+        EXPECT_NEAR(top[1], t.topY, 1e-5f);
+      }
+    }
+    EXPECT_NEAR(dir[0][0] * dir[1][0] + dir[0][1] * dir[1][1], 0.0f, 1e-5f) << "at right angles";
+    EXPECT_NEAR(dir[0][0] / std::hypot(dir[0][0], dir[0][1]), std::cos(t.angle), 1e-5f)
+        << "the first quad keeps the tuft's angle";
+  }
+}
+
+// One upright tuft seen from above (60 degrees down), turned in 10-degree steps: a single quad
+// turns edge-on (a line) twice per half turn; the crossed pair always shows at least half of its
+// broadest view, so no tuft reads as a flat card from above.
+TEST(RenderTufts, FromAboveATuftNeverTurnsEdgeOn) {
+  Scene ground = flatGround();
+  const Camera camera = Camera::lookingAt(0, 2.6f, -1.5f, 0, 0.3f, 0);
+  const Image bare = renderWith(ground, camera, {});
+  int least = 1 << 30, most = 0;
+  for (int step = 0; step < 18; ++step) {
+    Scene s = ground;
+    viewer::TuftInstance t{};
+    t.halfWidth = 0.5f;
+    t.topY = 0.6f;
+    t.angle = float(step) * 10.0f * Camera::kRadians;
+    s.tufts.push_back(t);
+    s.simulatedTufts = 1;
+    const Image img = renderWith(s, camera, {});
+    int covered = 0;
+    for (int y = 0; y < kHeight; ++y)
+      for (int x = 0; x < kWidth; ++x)
+        for (int c = 0; c < 3; ++c)
+          if (std::abs(int(img.at(x, y)[c]) - int(bare.at(x, y)[c])) > 8) {
+            ++covered;
+            break;
+          }
+    least = std::min(least, covered);
+    most = std::max(most, covered);
+  }
+  std::printf("tuft from above: %d to %d covered pixels over half a turn\n", least, most);
+  ASSERT_GT(most, 150);
+  EXPECT_GT(double(least) / most, 0.45) << "a single quad would vanish edge-on";
+}
+
+// On hilly-meadow every bottom corner of every tuft lies on the simulation's terrain (the quad's
+// flat bottom edge would float or sink by up to half a width times the slope), and the top edge
+// keeps the tuft's height above it.
+TEST(RenderTerrain, BottomCornersFollowTheHills) {
+  const Loaded l = load("hilly-meadow.json", 10);
+  Scene scene;
+  viewer::extractScene(*l.world, l.scenario, &scene);
+  const auto v = offscreen().renderer().captureTuftCorners(scene);
+  ASSERT_EQ(v.size(), scene.tufts.size() * 8);
+  double worst = 0, flatWorst = 0, heightWorst = 0;
+  for (size_t k = 0; k < scene.tufts.size(); k += 7) {  // every 7th tuft: 3,258 of them
+    const viewer::TuftInstance& t = scene.tufts[k];
+    for (int q = 0; q < 2; ++q)
+      for (int c = 0; c < 2; ++c) {
+        const auto b = corner(v, k, q, c), top = corner(v, k, q, c + 2);
+        const double terrain = viewer::groundHeight(*l.world, b[0], b[2]);
+        worst = std::max(worst, std::fabs(b[1] - terrain));
+        flatWorst = std::max(flatWorst, std::fabs(double(t.y) - terrain));
+        heightWorst = std::max(heightWorst, std::fabs(double(top[1] - b[1]) - double(t.topY - t.y)));
+      }
+  }
+  std::printf("terrain: bottom corners within %.2f mm of the terrain (a flat bottom edge: %.0f mm)\n", worst * 1e3,
+              flatWorst * 1e3);
+  EXPECT_LT(worst, 0.002) << "m";
+  EXPECT_GT(flatWorst, 0.05) << "the hills are steep enough for the test to mean something";
+  EXPECT_LT(heightWorst, 0.002) << "the blades keep their height above the slope";
+}
+
+/// The patch nearest to (x, z) among the scene's simulated tufts (the window is the field here).
+size_t nearestTuft(const Scene& s, float x, float z) {
+  size_t best = 0;
+  float bestD = 1e30f;
+  for (size_t k = 0; k < s.simulatedTufts; ++k) {
+    const float d = std::hypot(s.tufts[k].x - x, s.tufts[k].z - z);
+    if (d < bestD) bestD = d, best = k;
+  }
+  return best;
+}
+
+/// thesis-bodies extracted every `every` ticks up to `last` into one scene; the football's
+/// centre at each tick in `at` is recorded (x, z).
+Scene bodiesTrail(int64_t every, int64_t last, std::map<int64_t, std::array<float, 2>>* at = nullptr) {
+  Loaded l = load("thesis-bodies.json");
+  Scene scene;
+  while (true) {
+    if (l.world->tick() % every == 0) viewer::extractScene(*l.world, l.scenario, &scene);
+    if (at) {
+      const auto* w = dynamic_cast<const World<Fx32>*>(l.world.get());
+      const auto& p = w->bodies()[0].position;
+      (*at)[l.world->tick()] = {float(p.x().toDouble()), float(p.z().toDouble())};
+    }
+    if (l.world->tick() >= last) break;
+    const StepResult r = l.world->step(scriptedInput(l.scenario, l.world->tick()));
+    if (!r.ok) throw std::runtime_error(r.error.message());
+  }
+  return scene;
+}
+
+// The football rolls from x = -10 from tick 10. At tick 120 the grass it crossed around ticks
+// 40-70 (well behind it now) carries a trail; grass far from every body carries none; the trail is
+// drawn flatter and darker; it fades after kTrailSeconds; the same frames give the same trails,
+// and frames 40 ticks apart give the same path (swept between them).
+TEST(RenderTrail, APassedBodyLeavesADarkerFlatterTrailThatFades) {
+  std::map<int64_t, std::array<float, 2>> ball;
+  const Scene scene = bodiesTrail(1, 120, &ball);
+  const auto& now = ball[120];
+  std::vector<size_t> trail;
+  for (int64_t t = 40; t <= 70; t += 5) {
+    const auto& p = ball[t];
+    ASSERT_GT(std::hypot(p[0] - now[0], p[1] - now[1]), 1.5f) << "the ball has moved on";
+    const size_t k = nearestTuft(scene, p[0], p[1]);
+    EXPECT_GT(scene.tufts[k].trail, 128) << "tick " << t;
+    trail.push_back(k);
+  }
+  size_t far = 0;  // untouched: tufts 4 m or more from the ball's path and every body
+  for (size_t k = 0; k < scene.simulatedTufts; ++k) {
+    const viewer::TuftInstance& t = scene.tufts[k];
+    bool away = true;
+    for (const auto& [tick, p] : ball) away = away && std::hypot(t.x - p[0], t.z - p[1]) > 4.0f;
+    for (const viewer::BodyPartDraw& b : scene.bodyParts)
+      away = away && std::hypot(t.x - b.model[12], t.z - b.model[14]) > 4.0f;
+    if (!away) continue;
+    ++far;
+    ASSERT_EQ(t.trail, 0) << "tuft " << k << " at " << t.x << ", " << t.z;
+  }
+  EXPECT_GT(far, size_t(10000));
+
+  // Flatter: the drawn top of a trail tuft is lower than its simulated top.
+  const auto v = offscreen().renderer().captureTuftCorners(scene);
+  for (size_t k : trail) {
+    const viewer::TuftInstance& t = scene.tufts[k];
+    const float drawn = corner(v, k, 0, 2)[1] - corner(v, k, 0, 0)[1];
+    EXPECT_LT(drawn, 0.8f * (t.topY - t.y)) << "tuft " << k;
+  }
+  // Darker: the same frame without the trail is brighter where the trail is, identical elsewhere.
+  const Camera camera = Camera::lookingAt(ball[55][0], 6, ball[55][1] - 4, ball[55][0], 0, ball[55][1]);
+  Scene plain = scene;
+  for (viewer::TuftInstance& t : plain.tufts) t.trail = 0;
+  const Image with = renderWith(scene, camera, {}), without = renderWith(plain, camera, {});
+  int px, py;
+  ASSERT_TRUE(project(camera, ball[55][0], 0.3f, ball[55][1], &px, &py));
+  const double ratio = meanLuminance(with, px, py, 4) / meanLuminance(without, px, py, 4);
+  std::printf("trail: %.2f of the untouched brightness on the path\n", ratio);
+  EXPECT_LT(ratio, 0.9);
+
+  // Deterministic, and the same path from frames 40 ticks apart (swept between them).
+  const Scene again = bodiesTrail(1, 120), sparse = bodiesTrail(40, 120);
+  for (size_t k = 0; k < scene.tufts.size(); ++k) ASSERT_EQ(scene.tufts[k].trail, again.tufts[k].trail) << k;
+  for (size_t k : trail) EXPECT_GT(sparse.tufts[k].trail, 64) << "tuft " << k;
+
+  // Faded: kTrailSeconds (480 ticks) after the ball left, nothing of the early path remains.
+  const Scene later = bodiesTrail(10, 120 + 500);
+  for (size_t k : trail) EXPECT_LT(later.tufts[k].trail, scene.tufts[k].trail);
+  const auto earliest = trail.front();
+  EXPECT_EQ(later.tufts[earliest].trail, 0) << "pressed at tick 40, faded by tick 520";
+}
+
+/// Mean luminance per `block` x `block` pixel block.
+std::vector<double> blockMeans(const Image& img, int block) {
+  std::vector<double> out;
+  for (int by = 0; by + block <= img.height; by += block)
+    for (int bx = 0; bx + block <= img.width; bx += block)
+      out.push_back(meanLuminance(img, bx + block / 2, by + block / 2, block / 2));
+  return out;
+}
+
+double stddev(const std::vector<double>& v) {
+  double m = 0, s = 0;
+  for (double x : v) m += x;
+  m /= double(v.size());
+  for (double x : v) s += (x - m) * (x - m);
+  return std::sqrt(s / double(v.size()));
+}
+
+// The meadow from 20 m above (23 x 17 m of it in view), rendered with and without the colour
+// variation. Their ratio (the variation alone, whatever the view itself does to brightness) spans
+// well over 20 % across the view and changes slowly: 16 x 16 pixel blocks (1.2 m of meadow) are
+// like their neighbours, large-scale variation and not noise. The blocks' own brightness varies
+// clearly more with it than without.
+TEST(RenderColour, TheMeadowVariesAtLargeScale) {
+  const Loaded l = load("thesis-meadow.json");
+  Scene scene;
+  viewer::extractScene(*l.world, l.scenario, &scene);
+  Camera camera;
+  camera.y = 20, camera.pitchDegrees = -89.9f;
+  viewer::OffscreenRenderer& r = offscreen();
+  const Image varied = renderWith(scene, camera, {});
+  const float saved = r.renderer().lighting().colourVariation;
+  r.renderer().lighting().colourVariation = 0;
+  const Image uniform = renderWith(scene, camera, {});
+  r.renderer().lighting().colourVariation = saved;
+  constexpr int kBlock = 16, perRow = kWidth / kBlock;
+  const std::vector<double> a = blockMeans(varied, kBlock), b = blockMeans(uniform, kBlock);
+  std::vector<double> ratio(a.size());
+  for (size_t i = 0; i < a.size(); ++i) ratio[i] = a[i] / b[i];
+  const auto [lo, hi] = std::minmax_element(ratio.begin(), ratio.end());
+  double mean = 0, num = 0, den = 0;
+  for (double x : ratio) mean += x;
+  mean /= double(ratio.size());
+  for (size_t i = 0; i < ratio.size(); ++i) {
+    den += (ratio[i] - mean) * (ratio[i] - mean);
+    if ((i + 1) % size_t(perRow) != 0 && i + 1 < ratio.size()) num += (ratio[i] - mean) * (ratio[i + 1] - mean);
+  }
+  const double correlation = num / den;
+  std::printf(
+      "colour: brightness ratio %.2f to %.2f across the view, neighbour correlation %.2f; block brightness "
+      "std %.1f with the variation, %.1f without\n",
+      *lo, *hi, correlation, stddev(a), stddev(b));
+  EXPECT_GT(*hi - *lo, 0.2);
+  EXPECT_GT(correlation, 0.8);
+  EXPECT_GT(stddev(a), 1.5 * stddev(b));
+}
+
+// lod-crossing: ring tufts stand on the grass lattice, on lines through the ring cells' centre
+// patches (every edgeSpacing-th row or column); along a line they are one grass spacing apart,
+// and two neighbouring parallel lines are edgeSpacing spacings apart.
+TEST(RenderEdgeRing, RowsAreEdgeSpacingApartAndTuftsOneSpacingApart) {
+  const Loaded l = load("lod-crossing.json");
+  const auto* w = dynamic_cast<const World<Fx32>*>(l.world.get());
+  ASSERT_NE(w, nullptr);
+  Scene scene;
+  viewer::extractScene(*l.world, l.scenario, &scene);
+  const int64_t m = w->edgeRing().spacingMultiple;
+  ASSERT_EQ(m, 4);
+  const double spacing = w->lattice().spacing.toDouble(), ox = w->lattice().originX.toDouble(),
+               oz = w->lattice().originZ.toDouble(), jitter = w->lattice().jitterAmplitude.toDouble();
+  ASSERT_LT(jitter, 0.5 * spacing) << "rounding recovers the lattice index";
+  std::set<std::pair<int64_t, int64_t>> ring;
+  for (size_t k = scene.simulatedTufts; k < scene.tufts.size(); ++k) {
+    const viewer::TuftInstance& t = scene.tufts[k];
+    const int64_t i = std::llround((t.x - ox) / spacing), j = std::llround((t.z - oz) / spacing);
+    EXPECT_LT(std::fabs(t.x - (ox + double(i) * spacing)), jitter + 1e-3);
+    ring.insert({i, j});
+    EXPECT_FALSE(i >= scene.windowOriginI && i < scene.windowOriginI + scene.windowWidth && j >= scene.windowOriginJ &&
+                 j < scene.windowOriginJ + scene.windowHeight)
+        << "a ring tuft inside the simulated window";
+    EXPECT_TRUE((i - m / 2) % m == 0 || (j - m / 2) % m == 0) << i << ", " << j << " is on no ring line";
+    EXPECT_EQ(t.halfWidth, float(l.scenario.field.scaleXZ.toDouble())) << "as wide as the grass";
+  }
+  EXPECT_EQ(ring.size(), scene.tufts.size() - scene.simulatedTufts) << "no tuft twice";
+  // Beyond the window's +z side: rows along x. Their lines j are m apart; along a row, the tufts
+  // over the window's width are consecutive lattice columns.
+  const int64_t i0 = scene.windowOriginI, i1 = scene.windowOriginI + scene.windowWidth;
+  const int64_t jEnd = scene.windowOriginJ + scene.windowHeight;
+  std::map<int64_t, std::set<int64_t>> rows;
+  for (const auto& [i, j] : ring)
+    if (j >= jEnd && i >= i0 && i < i1) rows[j].insert(i);
+  ASSERT_GE(rows.size(), size_t(10));
+  int64_t previous = -1;
+  for (const auto& [j, columns] : rows) {
+    if (previous >= 0) {
+      EXPECT_EQ(j - previous, m) << "rows " << previous << " and " << j;
+    }
+    previous = j;
+    EXPECT_EQ(int64_t(columns.size()), i1 - i0) << "row " << j << ": a tuft at every grass spacing";
+  }
+  EXPECT_LT(rows.begin()->first - jEnd, m) << "the first row follows the window within a cell";
+  // In metres: a tuft's nearest neighbour in its row is about one grass spacing away.
+  const auto& row = rows.begin()->second;
+  std::vector<double> xs;
+  for (size_t k = scene.simulatedTufts; k < scene.tufts.size(); ++k) {
+    const viewer::TuftInstance& t = scene.tufts[k];
+    if (std::llround((t.z - oz) / spacing) == rows.begin()->first && row.count(std::llround((t.x - ox) / spacing)))
+      xs.push_back(t.x);
+  }
+  std::sort(xs.begin(), xs.end());
+  double gaps = 0;
+  for (size_t k = 1; k < xs.size(); ++k) gaps += xs[k] - xs[k - 1];
+  EXPECT_NEAR(gaps / double(xs.size() - 1), spacing, 0.01);
+  // Every ring line closes around the window: each of the first rows' 4 sides holds tufts.
+  EXPECT_GT(scene.tufts.size() - scene.simulatedTufts, size_t(m) * 1000);
+}
+
+/// Pixels of `img` that differ from the sky-only frame `sky` (the grass and ground region).
+std::vector<std::pair<int, int>> notSky(const Image& img, const Image& sky) {
+  std::vector<std::pair<int, int>> out;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      for (int c = 0; c < 3; ++c)
+        if (img.at(x, y)[c] != sky.at(x, y)[c]) {
+          out.push_back({x, y});
+          break;
+        }
+  return out;
+}
+
+// The thesis meadow at tick 120 from the default camera: SSAO darkens the grass clearly (today's
+// ambient-only AO: ~5/255) but not to black, and leaves every sky pixel bit-identical.
+TEST(RenderSsao, DarkensTheGrassVisiblyButNotToBlack) {
+  const Loaded l = load("thesis-meadow.json", 120);
+  Scene scene;
+  viewer::extractScene(*l.world, l.scenario, &scene);
+  const Camera camera = viewer::defaultCamera(scene, *l.world, float(kWidth) / kHeight);
+  viewer::RenderOptions off, on;
+  on.ssao = true;
+  const Image a = renderWith(scene, camera, off), b = renderWith(scene, camera, on);
+  Scene empty;
+  empty.atlasVariants = scene.atlasVariants, empty.atlasSeed = scene.atlasSeed;
+  const Image sky = renderWith(empty, camera, off);
+  const auto grass = notSky(a, sky);
+  ASSERT_GT(grass.size(), size_t(kWidth * kHeight / 3));
+  double la = 0, lb = 0;
+  for (const auto& [x, y] : grass) la += luminance(a, x, y), lb += luminance(b, x, y);
+  la /= double(grass.size());
+  lb /= double(grass.size());
+  std::printf("SSAO: grass mean luminance %.1f without, %.1f with (%.1f levels, %.0f %% darker)\n", la, lb, la - lb,
+              100 * (1 - lb / la));
+  EXPECT_GT(la - lb, 12.0) << "visible";
+  EXPECT_GT(lb / la, 0.6) << "not black";
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      bool isSky = true;
+      for (int c = 0; c < 3; ++c) isSky = isSky && a.at(x, y)[c] == sky.at(x, y)[c];
+      if (!isSky) continue;
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(a.at(x, y)[c], b.at(x, y)[c]) << "sky pixel " << x << ", " << y;
+    }
+}
+
+// Bare hills: the terrain receives occlusion from grass and bodies only, so with neither its AO
+// is 1 everywhere (the old prepass let the hills and the grazing far ground darken themselves).
+TEST(RenderSsao, BareTerrainDoesNotOccludeItself) {
+  const Loaded l = load("hilly-meadow.json");
+  Scene scene;
+  viewer::extractScene(*l.world, l.scenario, &scene);
+  scene.tufts.clear();
+  scene.simulatedTufts = 0;
+  viewer::RenderOptions on;
+  on.ssao = true;
+  renderWith(scene, Camera::lookingAt(-6, 12, -14, 12, 2, 0), on);
+  const Image ao = offscreen().renderer().readAmbientOcclusion();
+  ASSERT_FALSE(ao.rgba.empty());
+  int lowest = 255;
+  for (size_t i = 0; i < ao.rgba.size(); i += 4) lowest = std::min(lowest, int(ao.rgba[i]));
+  EXPECT_EQ(lowest, 255) << "no terrain pixel occluded";
+}
+
+// A box floating 1.8 m above the meadow, seen from above: on screen its faces meet the grass, 2 m
+// and more behind it and more occluded. Along the silhouette the blurred AO of a box pixel must be
+// the mean of the raw (unblurred) AO of the box pixels around it, not of all of them: the blur
+// ignores neighbours at another depth (which surface a pixel shows comes from a render of the box
+// alone, not from depth). A plain box blur (every neighbour counted; the test runs it too) mixes
+// the grass' darker AO into the box.
+TEST(RenderSsao, TheBlurKeepsTheGrassOcclusionOffABodyInFrontOfIt) {
+  const Loaded l = load("thesis-meadow.json", 60);
+  Scene scene;
+  viewer::extractScene(*l.world, l.scenario, &scene);
+  const viewer::BodyPartDraw box = boxPart(0, 2.2f, 0, 0.4f);
+  scene.bodyParts.push_back(box);
+  const Camera camera = Camera::lookingAt(0, 4.0f, -2.5f, 0, 0, 1.5f);
+  viewer::RenderOptions on;
+  on.ssao = true;
+  Scene alone, sky;
+  alone.atlasVariants = sky.atlasVariants = scene.atlasVariants;
+  alone.atlasSeed = sky.atlasSeed = scene.atlasSeed;
+  alone.bodyParts.push_back(box);
+  const Image boxOnly = renderWith(alone, camera, {}), skyOnly = renderWith(sky, camera, {});
+  // Half-resolution pixel (x, y) shows the box when the full-resolution pixel it stands for does.
+  auto onBox = [&](int x, int y) {
+    for (int c = 0; c < 3; ++c)
+      if (boxOnly.at(2 * x, 2 * y + 1)[c] != skyOnly.at(2 * x, 2 * y + 1)[c]) return true;
+    return false;
+  };
+  struct Rim {
+    double offBoxMean = 0;  ///< mean |blurred - mean raw AO of the box pixels of the 4x4 window|
+    double grassShare = 0;  ///< mean (box-only raw mean - all-pixel raw mean): what a box blur mixes in
+    double blurred = 0;     ///< mean blurred AO
+    int pixels = 0;
+  };
+  auto measure = [&] {
+    renderWith(scene, camera, on);
+    const Image ao = offscreen().renderer().readAmbientOcclusion();
+    const Image raw = offscreen().renderer().readAmbientOcclusion(false);
+    Rim rim;
+    for (int y = 2; y < ao.height - 2; ++y)
+      for (int x = 2; x < ao.width - 2; ++x) {
+        if (!onBox(x, y)) continue;
+        // The blur's 4x4 window: GL rows y - 2 .. y + 1 bottom up, so image rows y - 1 .. y + 2.
+        double boxSum = 0, allSum = 0;
+        int boxN = 0;
+        for (int dy = -1; dy <= 2; ++dy)
+          for (int dx = -2; dx <= 1; ++dx) {
+            const double v = raw.at(x + dx, y + dy)[0];
+            allSum += v;
+            if (onBox(x + dx, y + dy)) boxSum += v, ++boxN;
+          }
+        if (boxN == 16) continue;  // not at the silhouette
+        ++rim.pixels;
+        rim.offBoxMean += std::fabs(ao.at(x, y)[0] - boxSum / boxN);
+        rim.grassShare += boxSum / boxN - allSum / 16;
+        rim.blurred += ao.at(x, y)[0];
+      }
+    rim.offBoxMean /= std::max(1, rim.pixels);
+    rim.grassShare /= std::max(1, rim.pixels);
+    rim.blurred /= std::max(1, rim.pixels);
+    return rim;
+  };
+  const Rim bilateral = measure();
+  float& tolerance = offscreen().renderer().lighting().ssaoBlurDepthTolerance;
+  const float saved = tolerance;
+  tolerance = 1e9f;
+  const Rim plain = measure();
+  tolerance = saved;
+  std::printf(
+      "SSAO blur: at the box's silhouette (%d pixels) the blurred AO is %.1f/255 from the box pixels' own "
+      "mean (mean %.0f/255); a box blur: %.1f/255 (mean %.0f/255); the grass would pull it down by %.1f\n",
+      bilateral.pixels, bilateral.offBoxMean, bilateral.blurred, plain.offBoxMean, plain.blurred, bilateral.grassShare);
+  ASSERT_GT(bilateral.pixels, 100);
+  ASSERT_GT(bilateral.grassShare, 10.0) << "the grass around the box is more occluded than the box";
+  // (Not 0: neighbours on the box at a slightly different depth count a little less.)
+  EXPECT_LT(bilateral.offBoxMean, 8.0) << "the grass' occlusion bleeds onto the box in front of it";
+  EXPECT_LT(bilateral.offBoxMean, 0.4 * plain.offBoxMean);
+  EXPECT_GT(bilateral.blurred, plain.blurred + 10.0);
 }
 
 // ---- simgrass render ------------------------------------------------------------------------------

@@ -340,6 +340,80 @@ TEST(ViewerControls, AbSideBySideHasADividerAndLabelsAndThePanelsBesideTheViews)
   EXPECT_GT(labelB, 5);
 }
 
+// ---- golden screenshots of the new views (docs/images/viewer-*.png) --------------------------------
+
+struct Rgba {
+  int width = 0, height = 0;
+  std::vector<unsigned char> px;
+};
+
+Rgba loadPng(const std::string& path) {
+  Rgba img;
+  int channels = 0;
+  unsigned char* data = stbi_load(path.c_str(), &img.width, &img.height, &channels, 4);
+  if (data) img.px.assign(data, data + size_t(img.width) * size_t(img.height) * 4);
+  stbi_image_free(data);
+  return img;
+}
+
+/// Compares the columns [x0, x1) of a screenshot with its golden in docs/images, with the render
+/// goldens' tolerances (tests/render_test.cpp: at most 1 % of the pixels off by more than 24 in a
+/// channel, mean difference under 2). SIMGRASS_UPDATE_GOLDEN_IMAGES=1 writes the golden instead
+/// (.ci/update-golden-images). Columns outside [x0, x1) hold wall-clock figures (frame times,
+/// the timing graph) and are not compared.
+void expectGolden(const std::string& shot, const std::string& name, int x0, int x1) {
+  const std::string golden = test::sourcePath("docs/images/" + name);
+  if (std::getenv("SIMGRASS_UPDATE_GOLDEN_IMAGES")) {
+    fs::copy_file(shot, golden, fs::copy_options::overwrite_existing);
+    std::printf("wrote %s\n", golden.c_str());
+    return;
+  }
+  const Rgba a = loadPng(shot), b = loadPng(golden);
+  ASSERT_FALSE(a.px.empty()) << shot;
+  ASSERT_FALSE(b.px.empty()) << golden << " is missing: run .ci/update-golden-images";
+  ASSERT_EQ(a.width, b.width);
+  ASSERT_EQ(a.height, b.height);
+  int64_t differing = 0, pixels = 0;
+  double sum = 0;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = x0; x < x1; ++x) {
+      const size_t o = (size_t(y) * size_t(a.width) + size_t(x)) * 4;
+      int worst = 0;
+      for (int c = 0; c < 3; ++c) {
+        const int d = std::abs(int(a.px[o + size_t(c)]) - int(b.px[o + size_t(c)]));
+        worst = std::max(worst, d);
+        sum += d;
+      }
+      differing += worst > 24;
+      ++pixels;
+    }
+  const double fraction = double(differing) / double(pixels), mean = sum / (3.0 * double(pixels));
+  EXPECT_LE(fraction, 0.01) << name << ": " << fraction * 100 << "% of the pixels differ (the shot: " << shot << ")";
+  EXPECT_LT(mean, 2.0) << name << ": mean difference " << mean;
+}
+
+TEST(ViewerControls, ScreenshotsOfTheNewViewsMatchTheirGoldens) {
+  if (!onPath("xvfb-run")) GTEST_SKIP() << "xvfb-run is not on PATH";
+  TempDir dir;
+  // Live: the football selected (outlined), the help overlay over hidden panels; then the panels
+  // (live control, timing graph) over the scene after 30 ticks.
+  const std::string live =
+      dir.write("live.txt", "camera -10 1.3 -7 0 -18\nselect 0\nframes 2\ntap f2\ntap f1\nframes 1\nscreenshot " +
+                                dir.file("help.png") + "\ntap f1\ntap f2\nframes 30\npause\nframes 1\nscreenshot " +
+                                dir.file("panels.png") + "\nquit\n");
+  const CliResult v =
+      runViewer(scenario("thesis-bodies.json") + " --script " + quote(live) + " --size 640x360 --msaa 0");
+  ASSERT_EQ(v.exitCode, 0) << v.describe();
+  expectGolden(dir.file("help.png"), "viewer-help.png", 0, 640);
+  expectGolden(dir.file("panels.png"), "viewer-panels.png", 360, 640);  // the scene beside the panels
+  // A/B side by side: the two views, their labels and the divider (the panel column: timings).
+  const std::string ab = dir.write("ab.txt", "step 90\nframes 1\nscreenshot " + dir.file("ab.png") + "\nquit\n");
+  const CliResult a = runViewer(quote(test::sourcePath("scenarios/recordings/thesis-bodies-fx32.sgr")) +
+                                " --ab-variant interp=2 --script " + quote(ab) + " --size 640x360 --msaa 0");
+  ASSERT_EQ(a.exitCode, 0) << a.describe();
+  expectGolden(dir.file("ab.png"), "viewer-ab-side.png", 0, 2 * ((640 - 213) / 2));
+}
+
 TEST(ViewerControls, BadControlLinesAreOneLineAndExit2) {
   TempDir dir;
   for (const char* line : {"mouse -1 0", "mouse 1", "button middle down", "button left sideways", "tap nokey", "back x",

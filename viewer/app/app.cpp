@@ -265,9 +265,7 @@ bool App::simulate(double wall, std::string* error) {
     steps = std::min(steps, 8);
   }
   const StageClock before = live_->clock;
-  FrameTiming& frame = timing_[timingNext_ % kTimingFrames];
-  frame = FrameTiming{};
-  ++timingNext_;
+  FrameTiming& frame = timing_[(timingNext_ + kTimingFrames - 1) % kTimingFrames];  // this frame's
   for (int i = 0; i < steps; ++i) {
     // The tick before the last of this frame is what display interpolation starts from.
     if (i + 1 == steps && interpolate_ && !scripted_ && !paused_) extractScene(world(), scenario(), &previous_);
@@ -307,11 +305,17 @@ bool App::simulate(double wall, std::string* error) {
 
 void App::buildScenes(float alpha) {
   extractScene(world(), scenario(), &scene_);
+  scene_.debug = {};
   if (render_.debug.any()) extractDebug(world(), scenario(), render_.debug, &scene_);
+  // The selected body, outlined (drawn over the scene: RenderOptions::overlay).
+  const bool outline = selected_ >= 0 && selected_ < world().counts().bodies;
+  if (outline) appendSelectionOutline(&scene_);
+  render_.overlay = outline;
   render_.heatMap = false;
   if (play_ && play_->hasB()) {
     if (abView_ == AbView::Side) {
       extractScene(play_->worldB(), play_->scenarioB(), &sceneB_);
+      sceneB_.debug = {};
       if (render_.debug.any()) extractDebug(play_->worldB(), play_->scenarioB(), render_.debug, &sceneB_);
     } else if (play_->measured()) {
       applyDivergenceHeat(play_->observationA(), play_->observationB(), heatFullScale_, &scene_);
@@ -333,19 +337,20 @@ void App::renderWorld(int fbw, int fbh) {
     renderer_->draw(a, cam_.camera, fbw, fbh, o);
     return;
   }
-  // Side by side, one camera: the renderer draws at the viewport origin and clears the whole
-  // framebuffer, so B goes first into the left half and is copied to the right; then A is drawn
-  // into the left half with the scissor keeping its clear off B.
-  const int half = fbw / 2;
+  // Side by side, one camera, each view abViewWidth wide (the panel column right of them): the
+  // renderer draws at the viewport origin and clears the whole framebuffer, so B goes first into
+  // [0, w) and is copied to [w, 2w) (the two never overlap); then A is drawn into [0, w) with the
+  // scissor keeping its clear off B.
+  const int w = abViewWidth(fbw);
   RenderOptions ob = o;
   ob.heatMap = false;
-  renderer_->draw(sceneB_, cam_.camera, half, fbh, ob);
+  renderer_->draw(sceneB_, cam_.camera, w, fbh, ob);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-  glBlitFramebuffer(0, 0, half, fbh, fbw - half, 0, fbw, fbh, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBlitFramebuffer(0, 0, w, fbh, w, 0, 2 * w, fbh, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   glEnable(GL_SCISSOR_TEST);
-  glScissor(0, 0, half, fbh);
-  renderer_->draw(a, cam_.camera, half, fbh, o);
+  glScissor(0, 0, w, fbh);
+  renderer_->draw(a, cam_.camera, w, fbh, o);
   glDisable(GL_SCISSOR_TEST);
   glViewport(0, 0, fbw, fbh);
 }
@@ -437,6 +442,7 @@ int App::run(const std::vector<ScriptCommand>* script, const std::string& startu
 
     // The cursor (a script's `mouse X Y` places it instead), then the frame's events in order.
     if (!scripted_) glfwGetCursorPos(window_, &cursorX_, &cursorY_);
+    timing_[timingNext_++ % kTimingFrames] = FrameTiming{};  // this frame's slot of the timing graph
     handleEvents();
     handleMouse();
     const double dt = scenario().timeStep.toDouble();
@@ -460,7 +466,9 @@ int App::run(const std::vector<ScriptCommand>* script, const std::string& startu
       const auto r0 = Clock::now();
       renderWorld(fbw, fbh);
       glFinish();
-      renderMs_ = 0.9 * renderMs_ + 0.1 * std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
+      const double ms = std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
+      renderMs_ = 0.9 * renderMs_ + 0.1 * ms;
+      timing_[(timingNext_ + kTimingFrames - 1) % kTimingFrames].renderMs = float(ms);
     }
     if (imgui_) {
       if (!uiHidden_) drawPanels();

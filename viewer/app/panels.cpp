@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cinttypes>
 #include <cstdio>
+#include <filesystem>
 
 #include "viewer/app/app.h"
 #include "viewer/app/keys.h"
@@ -249,12 +250,14 @@ void App::drawAbLabels(int fbw, int fbh) {
   const float w = float(abViewWidth(fbw)) * scale;
   ImDrawList* dl = ImGui::GetForegroundDrawList();
   dl->AddLine(ImVec2(w, 0), ImVec2(w, float(fbh) * scale), IM_COL32(255, 255, 255, 230), 3.0f);
-  auto label = [&](float x, const std::string& text) {
+  auto label = [&](float x, const std::string& text) {  // clipped to its own view
     const ImVec2 size = ImGui::CalcTextSize(text.c_str());
+    dl->PushClipRect(ImVec2(x, 0), ImVec2(x + w - 4, 40), true);
     dl->AddRectFilled(ImVec2(x + 6, 6), ImVec2(x + 14 + size.x, 12 + size.y), IM_COL32(0, 0, 0, 170));
     dl->AddText(ImVec2(x + 10, 9), IM_COL32(255, 255, 255, 255), text.c_str());
+    dl->PopClipRect();
   };
-  label(0, "A  " + play_->recording().file);
+  label(0, "A  " + std::filesystem::path(play_->recording().file).filename().string());
   std::string b = "B  " + play_->labelB();
   if (play_->measured()) {
     char buf[96];

@@ -3,6 +3,7 @@
 #include <GL/glew.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -44,7 +45,10 @@ GLuint compile(GLenum type, const std::string& source, const char* name) {
   return s;
 }
 
-GLuint link(const std::string& vertex, const std::string& fragment, const char* name) {
+/// Compiles and links a program; `captured` names vertex outputs to record by transform feedback
+/// (interleaved), set before linking as GL requires.
+GLuint link(const std::string& vertex, const std::string& fragment, const char* name,
+            const std::vector<const char*>& captured = {}) {
   const GLuint vs = compile(GL_VERTEX_SHADER, vertex, name);
   GLuint fs = 0;
   try {
@@ -56,6 +60,8 @@ GLuint link(const std::string& vertex, const std::string& fragment, const char* 
   const GLuint p = glCreateProgram();
   glAttachShader(p, vs);
   glAttachShader(p, fs);
+  if (!captured.empty())
+    glTransformFeedbackVaryings(p, GLsizei(captured.size()), captured.data(), GL_INTERLEAVED_ATTRIBS);
   glLinkProgram(p);
   glDeleteShader(vs);
   glDeleteShader(fs);
@@ -70,8 +76,11 @@ GLuint link(const std::string& vertex, const std::string& fragment, const char* 
 }
 
 std::string litFragment(const char* body) {
-  return std::string("#version 330 core\n") + shaders::kLightingFunctions + body;
+  return std::string("#version 330 core\n") + shaders::kLightingFunctions + shaders::kMeadowTint + body;
 }
+
+/// The tuft vertex shader (it tints by the meadow's colour variation).
+std::string tuftVertex() { return std::string("#version 330 core\n") + shaders::kMeadowTint + shaders::kTuftVertex; }
 
 GLint loc(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
 void set3(GLuint p, const char* name, const std::array<float, 3>& v) { glUniform3f(loc(p, name), v[0], v[1], v[2]); }
@@ -118,6 +127,30 @@ Mat4 inverse4(const Mat4& m) {
   det = 1.0f / det;
   for (float& v : inv) v *= det;
   return inv;
+}
+
+/// The six planes (a, b, c, d; inside: a x + b y + c z + d >= 0, (a, b, c) unit) of the frustum
+/// of a view-projection matrix (Gribb and Hartmann: the rows' sums and differences).
+std::array<std::array<float, 4>, 6> frustumPlanes(const Mat4& m) {
+  auto row = [&m](int r) {
+    return std::array<float, 4>{m[size_t(r)], m[size_t(4 + r)], m[size_t(8 + r)], m[size_t(12 + r)]};
+  };
+  const std::array<float, 4> r0 = row(0), r1 = row(1), r2 = row(2), r3 = row(3);
+  std::array<std::array<float, 4>, 6> planes{};
+  for (int k = 0; k < 4; ++k) {
+    planes[0][size_t(k)] = r3[size_t(k)] + r0[size_t(k)];  // left
+    planes[1][size_t(k)] = r3[size_t(k)] - r0[size_t(k)];  // right
+    planes[2][size_t(k)] = r3[size_t(k)] + r1[size_t(k)];  // bottom
+    planes[3][size_t(k)] = r3[size_t(k)] - r1[size_t(k)];  // top
+    planes[4][size_t(k)] = r3[size_t(k)] + r2[size_t(k)];  // near
+    planes[5][size_t(k)] = r3[size_t(k)] - r2[size_t(k)];  // far
+  }
+  for (auto& p : planes) {
+    const float l = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    if (l > 0)
+      for (float& v : p) v /= l;
+  }
+  return planes;
 }
 
 /// An indexed triangle mesh of position + normal (6 floats per vertex).
@@ -340,10 +373,17 @@ Image RenderTarget::read() {
 struct Renderer::Impl {
   GLuint tuftProgram = 0, groundProgram = 0, bodyProgram = 0, skyProgram = 0;
   GLuint prepassGround = 0, prepassBody = 0, prepassTuft = 0, ssaoProgram = 0, blurProgram = 0, debugProgram = 0;
+  GLuint captureProgram = 0;  ///< the tuft vertex shader with transform feedback of vWorld
   GLuint tuftVao = 0, tuftBuffer = 0, emptyVao = 0, debugVao = 0, debugBuffer = 0;
   size_t tuftCapacity = 0;
   Mesh sphere, cube, ground;
   uint64_t groundRevision = 0;
+  // The terrain under the tufts: the ground grid's inner heights as a float texture.
+  GLuint heightTexture = 0;
+  bool hasHeights = false;
+  float heightOrigin[2] = {0, 0}, heightStep[2] = {1, 1};
+  int heightCells[2] = {1, 1};
+  FrameStats stats;
   GLuint atlasTexture = 0, groundTexture = 0, rockTexture = 0;
   // SSAO targets (created for the viewport size on first use).
   int ssaoWidth = 0, ssaoHeight = 0;
@@ -403,6 +443,45 @@ struct Renderer::Impl {
     }
     ground.upload(v, idx);
     groundRevision = g.revision;
+    uploadHeights(g);
+  }
+
+  /// The inner part of the grid (without the skirt lines) as an R32F texture: the tuft vertex
+  /// shader puts each bottom corner on it. Its lines are evenly spaced (gridLines).
+  void uploadHeights(const GroundGrid& g) {
+    const size_t nx = g.xs.size(), nz = g.zs.size();
+    hasHeights = nx >= 4 && nz >= 4 && g.heights.size() == nx * nz;
+    if (!hasHeights) return;
+    const size_t ix = nx - 2, iz = nz - 2;  // inner lines 1 .. n - 2
+    std::vector<float> inner(ix * iz);
+    for (size_t j = 0; j < iz; ++j)
+      for (size_t i = 0; i < ix; ++i) inner[j * ix + i] = g.heights[(j + 1) * nx + i + 1];
+    heightOrigin[0] = g.xs[1];
+    heightOrigin[1] = g.zs[1];
+    heightStep[0] = (g.xs[nx - 2] - g.xs[1]) / float(ix - 1);
+    heightStep[1] = (g.zs[nz - 2] - g.zs[1]) / float(iz - 1);
+    heightCells[0] = int(ix - 1);
+    heightCells[1] = int(iz - 1);
+    if (!heightTexture) glGenTextures(1, &heightTexture);
+    glBindTexture(GL_TEXTURE_2D, heightTexture);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, GLsizei(ix), GLsizei(iz), 0, GL_RED, GL_FLOAT, inner.data());
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  }
+
+  /// The height texture on unit 3 and its uniforms, for a program running the tuft vertex shader.
+  void heightUniforms(GLuint p) const {
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D, hasHeights ? heightTexture : 0);
+    glUniform1i(loc(p, "uHeights"), 3);
+    glUniform1i(loc(p, "uHasHeights"), hasHeights ? 1 : 0);
+    glUniform2f(loc(p, "uHeightOrigin"), heightOrigin[0], heightOrigin[1]);
+    glUniform2f(loc(p, "uHeightStep"), heightStep[0], heightStep[1]);
+    glUniform2i(loc(p, "uHeightCells"), heightCells[0], heightCells[1]);
+    glActiveTexture(GL_TEXTURE0);
   }
 
   /// The mesh for `path` (resolved against `directory`), loading it on first use; null with
@@ -461,7 +540,7 @@ struct Renderer::Impl {
 
   ~Impl() {
     for (GLuint p : {tuftProgram, groundProgram, bodyProgram, skyProgram, prepassGround, prepassBody, prepassTuft,
-                     ssaoProgram, blurProgram, debugProgram})
+                     ssaoProgram, blurProgram, debugProgram, captureProgram})
       if (p) glDeleteProgram(p);
     for (GLuint* b : {&tuftBuffer, &debugBuffer})
       if (*b) glDeleteBuffers(1, b);
@@ -472,20 +551,21 @@ struct Renderer::Impl {
     ground.release();
     for (auto& [path, m] : meshes) m.mesh.release();
     releaseSsaoTargets();
-    for (GLuint* t : {&atlasTexture, &groundTexture, &rockTexture})
+    for (GLuint* t : {&atlasTexture, &groundTexture, &rockTexture, &heightTexture})
       if (*t) glDeleteTextures(1, t);
   }
 };
 
 Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
   Impl& r = *impl_;
-  r.tuftProgram = link(shaders::kTuftVertex, litFragment(shaders::kTuftFragment), "tuft");
+  r.tuftProgram = link(tuftVertex(), litFragment(shaders::kTuftFragment), "tuft");
   r.groundProgram = link(shaders::kGroundVertex, litFragment(shaders::kGroundFragment), "ground");
   r.bodyProgram = link(shaders::kBodyVertex, litFragment(shaders::kBodyFragment), "body");
   r.skyProgram = link(shaders::kSkyVertex, shaders::kSkyFragment, "sky");
   r.prepassGround = link(shaders::kGroundVertex, shaders::kPrepassSolidFragment, "prepass ground");
   r.prepassBody = link(shaders::kBodyVertex, shaders::kPrepassSolidFragment, "prepass body");
-  r.prepassTuft = link(shaders::kTuftVertex, shaders::kPrepassTuftFragment, "prepass tuft");
+  r.prepassTuft = link(tuftVertex(), shaders::kPrepassTuftFragment, "prepass tuft");
+  r.captureProgram = link(tuftVertex(), shaders::kCaptureFragment, "tuft capture", {"vWorld"});
   r.ssaoProgram = link(shaders::kFullscreenVertex, shaders::kSsaoFragment, "ssao");
   r.blurProgram = link(shaders::kFullscreenVertex, shaders::kBlurFragment, "ssao blur");
   r.debugProgram = link(shaders::kDebugVertex, shaders::kDebugFragment, "debug");
@@ -505,16 +585,17 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
   glBindBuffer(GL_ARRAY_BUFFER, r.tuftBuffer);
   static_assert(sizeof(TuftInstance) == 36, "TuftInstance is uploaded as is");
   const GLsizei stride = sizeof(TuftInstance);
+  // Divisor 2: each tuft is two instances, the crossed quads (gl_InstanceID & 1 picks one).
   glEnableVertexAttribArray(0);
   glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<const void*>(offsetof(TuftInstance, x)));
-  glVertexAttribDivisor(0, 1);
+  glVertexAttribDivisor(0, 2);
   glEnableVertexAttribArray(1);
   glVertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<const void*>(offsetof(TuftInstance, topY)));
-  glVertexAttribDivisor(1, 1);
+  glVertexAttribDivisor(1, 2);
   glEnableVertexAttribArray(2);
-  glVertexAttribPointer(2, 3, GL_UNSIGNED_BYTE, GL_FALSE, stride,  // variant, level, heat
+  glVertexAttribPointer(2, 4, GL_UNSIGNED_BYTE, GL_FALSE, stride,  // variant, level, heat, trail
                         reinterpret_cast<const void*>(offsetof(TuftInstance, variant)));
-  glVertexAttribDivisor(2, 1);
+  glVertexAttribDivisor(2, 2);
   glBindVertexArray(0);
   sphereMesh(&r.sphere);
   cubeMesh(&r.cube);
@@ -523,6 +604,60 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
 Renderer::~Renderer() = default;
 
 const TuftAtlas* Renderer::atlas() const { return impl_->atlas.get(); }
+
+float Renderer::cullDistance() const { return std::sqrt(std::log(255.0f)) / lighting_.fogDensity; }
+
+const FrameStats& Renderer::lastFrameStats() const { return impl_->stats; }
+
+std::vector<std::array<float, 3>> Renderer::captureTuftCorners(const Scene& scene) {
+  Impl& r = *impl_;
+  std::vector<std::array<float, 3>> out;
+  const size_t n = scene.tufts.size();
+  if (n == 0) return out;
+  r.ensureAtlas(std::clamp(scene.atlasVariants, 1, 16), scene.atlasSeed);
+  if (r.groundRevision != scene.ground.revision) r.uploadGround(scene.ground);
+  const size_t vertices = n * 2 * 4;  // two quads of four corners per tuft
+  GLuint feedback = 0;
+  glGenBuffers(1, &feedback);
+  glBindBuffer(GL_TRANSFORM_FEEDBACK_BUFFER, feedback);
+  glBufferData(GL_TRANSFORM_FEEDBACK_BUFFER, GLsizeiptr(vertices * 3 * sizeof(float)), nullptr, GL_STATIC_READ);
+  glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, feedback);
+  glBindVertexArray(r.tuftVao);
+  glBindBuffer(GL_ARRAY_BUFFER, r.tuftBuffer);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(n * sizeof(TuftInstance)), scene.tufts.data(), GL_STREAM_DRAW);
+  r.tuftCapacity = n;
+  GLuint p = r.captureProgram;
+  glUseProgram(p);
+  r.heightUniforms(p);
+  glUniform1f(loc(p, "uTrailFlatten"), lighting_.trailFlatten);
+  glUniform1f(loc(p, "uCrossWidth"), lighting_.crossWidth);
+  glUniform1f(loc(p, "uVariation"), lighting_.colourVariation);
+  const Mat4 identity = identity4();
+  setMat(p, "uViewProj", identity);
+  std::vector<float> tiles;
+  for (int v = 0; v <= r.atlas->variants; ++v)
+    for (int l = 0; l < r.atlas->levels; ++l) {
+      const TuftAtlas::Rect t = r.atlas->tile(v, l);
+      tiles.insert(tiles.end(), {t.u0, t.v0, t.u1, t.v1});
+    }
+  glUniform4fv(loc(p, "uTiles"), GLsizei(std::min<size_t>(tiles.size() / 4, kMaxTiles)), tiles.data());
+  glUniform1i(loc(p, "uLevels"), r.atlas->levels);
+  // Points, not the strip: each vertex is recorded once, in gl_VertexID order per instance.
+  glEnable(GL_RASTERIZER_DISCARD);
+  glBeginTransformFeedback(GL_POINTS);
+  glDrawArraysInstanced(GL_POINTS, 0, 4, GLsizei(2 * n));
+  glEndTransformFeedback();
+  glDisable(GL_RASTERIZER_DISCARD);
+  std::vector<float> raw(vertices * 3);
+  glGetBufferSubData(GL_TRANSFORM_FEEDBACK_BUFFER, 0, GLsizeiptr(raw.size() * sizeof(float)), raw.data());
+  glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0);
+  glDeleteBuffers(1, &feedback);
+  glBindVertexArray(0);
+  glUseProgram(0);
+  out.resize(vertices);
+  for (size_t i = 0; i < vertices; ++i) out[i] = {raw[3 * i], raw[3 * i + 1], raw[3 * i + 2]};
+  return out;
+}
 
 void Renderer::draw(const Scene& scene, const Camera& camera, int width, int height, bool alphaToCoverage) {
   RenderOptions options;
@@ -534,7 +669,7 @@ void Renderer::setAssetDirectory(const std::string& directory) { impl_->assetDir
 
 const std::string& Renderer::lastAssetError() const { return impl_->lastAssetError; }
 
-Image Renderer::readAmbientOcclusion() {
+Image Renderer::readAmbientOcclusion(bool blurred) {
   Impl& r = *impl_;
   Image img;
   if (!r.aoValid) return img;
@@ -543,7 +678,7 @@ Image Renderer::readAmbientOcclusion() {
   img.width = std::max(1, r.ssaoWidth / 2);
   img.height = std::max(1, r.ssaoHeight / 2);
   std::vector<uint8_t> raw(size_t(img.width) * size_t(img.height) * 4);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, r.aoFbo[1]);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, r.aoFbo[blurred ? 1 : 0]);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadPixels(0, 0, img.width, img.height, GL_RGBA, GL_UNSIGNED_BYTE, raw.data());
   glBindFramebuffer(GL_READ_FRAMEBUFFER, GLuint(previous));
@@ -596,17 +731,44 @@ void Renderer::draw(const Scene& scene, const Camera& camera, int width, int hei
     }
   }
 
-  // Tufts front to back: the depth test then rejects most hidden tuft fragments before shading
-  // (a software rasteriser pays for every shaded fragment). Uploaded once for both passes.
-  const size_t n = scene.tufts.size();
-  if (n > 0) {
-    r.order.resize(n);
-    for (size_t i = 0; i < n; ++i) {
-      const TuftInstance& t = scene.tufts[i];
-      const float dx = t.x - camera.x, dz = t.z - camera.z;
-      r.order[i] = {dx * dx + dz * dz, uint32_t(i)};
+  // Tufts: culled to the view frustum and the fog distance, then front to back (the depth test
+  // then rejects most hidden tuft fragments before shading; a software rasteriser pays for every
+  // shaded fragment). Uploaded once for both passes.
+  const auto cullStart = std::chrono::steady_clock::now();
+  r.stats = {};
+  r.stats.tufts = scene.tufts.size();
+  const std::array<std::array<float, 4>, 6> planes = frustumPlanes(viewProj);
+  const float cullDistance = this->cullDistance();
+  r.order.clear();
+  r.order.reserve(scene.tufts.size());
+  for (size_t i = 0; i < scene.tufts.size(); ++i) {
+    const TuftInstance& t = scene.tufts[i];
+    const float dx = t.x - camera.x, dz = t.z - camera.z;
+    if (options.cull) {
+      // A sphere around both quads: centred half way up, reaching the tip-shifted top corners;
+      // plus one half width for the terrain lift of the bottom corners (slopes up to 45 degrees).
+      const float h = std::fabs(t.topY - t.y), tip = std::sqrt(t.tipX * t.tipX + t.tipZ * t.tipZ);
+      const float cx = t.x + 0.5f * t.tipX, cy = t.y + 0.5f * h, cz = t.z + 0.5f * t.tipZ;
+      const float across = t.halfWidth + 0.5f * tip, up = 0.5f * h + t.halfWidth;
+      const float radius = std::sqrt(across * across + up * up);
+      const float ex = cx - camera.x, ey = cy - camera.y, ez = cz - camera.z;
+      if (std::sqrt(ex * ex + ey * ey + ez * ez) - radius > cullDistance) {
+        ++r.stats.distanceCulled;
+        continue;
+      }
+      bool outside = false;
+      for (const auto& pl : planes) outside = outside || pl[0] * cx + pl[1] * cy + pl[2] * cz + pl[3] < -radius;
+      if (outside) {
+        ++r.stats.frustumCulled;
+        continue;
+      }
     }
-    std::sort(r.order.begin(), r.order.end());
+    r.order.push_back({dx * dx + dz * dz, uint32_t(i)});
+  }
+  std::sort(r.order.begin(), r.order.end());
+  const size_t n = r.order.size();
+  r.stats.drawn = n;
+  if (n > 0) {
     r.sorted.resize(n);
     for (size_t i = 0; i < n; ++i) r.sorted[i] = scene.tufts[r.order[i].second];
     glBindVertexArray(r.tuftVao);
@@ -619,6 +781,8 @@ void Renderer::draw(const Scene& scene, const Camera& camera, int width, int hei
       glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(bytes), r.sorted.data());
     }
   }
+  r.stats.cullAndSortMs =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cullStart).count();
   std::vector<float> tiles;
   const TuftAtlas& atlas = *r.atlas;
   for (int v = 0; v <= atlas.variants; ++v)
@@ -627,6 +791,12 @@ void Renderer::draw(const Scene& scene, const Camera& camera, int width, int hei
       tiles.insert(tiles.end(), {t.u0, t.v0, t.u1, t.v1});
     }
   auto tuftUniforms = [&](GLuint p) {
+    r.heightUniforms(p);
+    glUniform1f(loc(p, "uTrailFlatten"), L.trailFlatten);
+    glUniform1f(loc(p, "uTrailDarken"), L.trailDarken);
+    glUniform1f(loc(p, "uCrossWidth"), L.crossWidth);
+    glUniform1i(loc(p, "uMarkingVariant"), atlas.variants);
+    glUniform1f(loc(p, "uVariation"), L.colourVariation);
     glUniform4fv(loc(p, "uTiles"), GLsizei(std::min<size_t>(tiles.size() / 4, kMaxTiles)), tiles.data());
     glUniform1i(loc(p, "uLevels"), atlas.levels);
     glActiveTexture(GL_TEXTURE0);
@@ -660,10 +830,12 @@ void Renderer::draw(const Scene& scene, const Camera& camera, int width, int hei
     };
     if (r.ground.indices > 0) {
       prepass(r.prepassGround);
+      glUniform1f(loc(r.prepassGround, "uOccluder"), 0.0f);  // the terrain only receives
       r.ground.draw();
     }
     if (!draws.empty()) {
       prepass(r.prepassBody);
+      glUniform1f(loc(r.prepassBody, "uOccluder"), 1.0f);
       for (const Draw& d : draws) {
         setMat(r.prepassBody, "uModel", d.part->model);
         d.mesh->draw();
@@ -673,7 +845,7 @@ void Renderer::draw(const Scene& scene, const Camera& camera, int width, int hei
       prepass(r.prepassTuft);
       tuftUniforms(r.prepassTuft);
       glBindVertexArray(r.tuftVao);
-      glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(n));
+      glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(2 * n));
     }
     glDisable(GL_DEPTH_TEST);
     glDepthMask(GL_FALSE);
@@ -698,6 +870,11 @@ void Renderer::draw(const Scene& scene, const Camera& camera, int width, int hei
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, r.aoTexture[0]);
     glUniform1i(loc(r.blurProgram, "uSource"), 0);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, r.prepassDepth);
+    glUniform1i(loc(r.blurProgram, "uDepth"), 1);
+    setMat(r.blurProgram, "uInvProj", inverse4(projection));
+    glUniform1f(loc(r.blurProgram, "uDepthTolerance"), L.ssaoBlurDepthTolerance);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindFramebuffer(GL_FRAMEBUFFER, GLuint(hostFbo));
     r.aoValid = true;
@@ -732,8 +909,12 @@ void Renderer::draw(const Scene& scene, const Camera& camera, int width, int hei
     const float ex = std::fabs(m[0]) + std::fabs(m[4]) + std::fabs(m[8]);
     const float ey = std::fabs(m[1]) + std::fabs(m[5]) + std::fabs(m[9]);
     const float ez = std::fabs(m[2]) + std::fabs(m[6]) + std::fabs(m[10]);
-    const float radius = b->shape == BodyPartDraw::Shape::Sphere ? ey : 0.5f * (ex + ez);
-    shadows.insert(shadows.end(), {m[12], m[14], radius, m[13] - ey});
+    // A sphere's model is a rotation times its radius: a column's length (the row sums ex, ey, ez
+    // bound a box's extent and overstate a turned sphere's).
+    const float sphere = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+    const bool isSphere = b->shape == BodyPartDraw::Shape::Sphere;
+    const float radius = isSphere ? sphere : 0.5f * (ex + ez);
+    shadows.insert(shadows.end(), {m[12], m[14], radius, m[13] - (isSphere ? sphere : ey)});
   }
   // The blurred AO on unit 1 for every lit program (the textures of a pass use unit 0 and 2).
   glActiveTexture(GL_TEXTURE1);
@@ -751,6 +932,8 @@ void Renderer::draw(const Scene& scene, const Camera& camera, int width, int hei
     if (!shadows.empty()) glUniform4fv(loc(p, "uShadows"), GLsizei(shadows.size() / 4), shadows.data());
     glUniform1i(loc(p, "uSsao"), r.aoValid ? 1 : 0);
     glUniform1i(loc(p, "uAo"), 1);
+    glUniform1f(loc(p, "uAoDirect"), L.ssaoDirect);
+    glUniform1f(loc(p, "uVariation"), L.colourVariation);
     glUniform2f(loc(p, "uViewport"), float(width), float(height));
   };
 
@@ -791,13 +974,13 @@ void Renderer::draw(const Scene& scene, const Camera& camera, int width, int hei
     glUniform1i(loc(r.tuftProgram, "uHeatMap"), options.heatMap ? 1 : 0);
     glBindVertexArray(r.tuftVao);
     if (alphaToCoverage) glEnable(GL_SAMPLE_ALPHA_TO_COVERAGE);
-    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(n));
+    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(2 * n));
     if (alphaToCoverage) glDisable(GL_SAMPLE_ALPHA_TO_COVERAGE);
   }
 
   // 5. Debug overlay: over everything (no depth test), unlit, unfogged.
   const DebugScene& dbg = scene.debug;
-  if (options.debug.any() && (!dbg.lines.empty() || !dbg.points.empty())) {
+  if ((options.debug.any() || options.overlay) && (!dbg.lines.empty() || !dbg.points.empty())) {
     std::vector<float> v;
     v.reserve(dbg.lines.size() * 14 + dbg.points.size() * 7);
     for (const DebugScene::Line& l : dbg.lines) {

@@ -5,13 +5,16 @@
 //      normals, with soft contact shadows under the bodies;
 //   3. bodies: unit spheres and cubes per part under their pose, Lambert + ambient (a football
 //      gets dark pentagons);
-//   4. tufts: one instance per tuft (simulated and edge ring), the vertex shader builds the quad;
-//      alpha test at 0.5 without MSAA, sharpened alpha to coverage with it; all normals up;
+//   4. tufts: two crossed quads per tuft (simulated and edge ring), built by the vertex shader
+//      with their bottom corners on the terrain, culled on the CPU to the view frustum and the
+//      fog distance, sorted front to back; alpha test at 0.5 without MSAA, sharpened alpha to
+//      coverage with it; all normals up; darker and flatter where a body pressed them (trail);
 //      optionally tinted by their divergence heat;
 //   5. the debug overlay (lines and points of Scene::debug), over everything.
-// Everything is fogged toward the horizon colour. With SSAO on, a prepass renders depth and
-// normals (tufts only where their alpha passes), an occlusion pass at half resolution and a blur
-// feed the ambient term of steps 2-4. Steep ground blends to a rock texture. Bodies naming an
+// Tufts and ground share a large-scale colour variation. Everything is fogged toward the horizon
+// colour. With SSAO on, a prepass renders depth and normals (tufts only where their alpha passes;
+// the terrain receives but does not occlude), an occlusion pass at half resolution and a
+// depth-aware blur darken steps 2-4. Steep ground blends to a rock texture. Bodies naming an
 // OBJ mesh draw it instead of their primitives (docs/rendering.md). A GL context (3.3 core or later) with loaded
 // entry points must be current for the whole life of a Renderer and a RenderTarget.
 #pragma once
@@ -20,6 +23,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "viewer/render/atlas.h"
 #include "viewer/render/camera.h"
@@ -42,6 +46,18 @@ struct Lighting {
   std::array<float, 2> rockSlopeDegrees{9.0f, 14.0f};
   float ssaoRadius = 0.5f;    ///< m: the SSAO neighbourhood
   float ssaoStrength = 1.2f;  ///< 1: all samples occluded -> no ambient
+  /// Share of the sun light the AO darkens too. The thesis multiplied its image by the AO; on
+  /// ambient light alone (40 % of the grass' light here) the effect was ~5/255, invisible.
+  float ssaoDirect = 0.6f;
+  float ssaoBlurDepthTolerance = 0.1f;  ///< relative view depth beyond which the blur ignores a neighbour
+  float colourVariation = 1.0f;         ///< amplitude of the meadow's large-scale colour variation (0: none)
+  /// Width of each of a tuft's two crossed quads relative to the thesis' one quad (2 x scaleXZ).
+  /// At 0.5 the pair covers about the screen area of the thesis' quad, so it costs about as much
+  /// to fill on a software rasteriser (whose cost is the tufts' fragments), and a tuft is a
+  /// clump 0.5 m across instead of a 1 m card.
+  float crossWidth = 0.5f;
+  float trailFlatten = 0.5f;  ///< share of its height a just-pressed tuft loses
+  float trailDarken = 0.3f;   ///< share of its brightness a just-pressed tuft loses
 };
 
 /// An offscreen framebuffer: colour + depth, multisampled when samples > 0 (resolved on read).
@@ -72,7 +88,20 @@ struct RenderOptions {
   bool ssao = false;            ///< screen-space ambient occlusion; tufts write depth by their alpha
   bool rockBlend = true;        ///< rock texture on steep terrain
   bool heatMap = false;         ///< tint tufts by TuftInstance::heat (divergence overlay)
+  bool cull = true;             ///< skip tufts outside the view frustum or past cullDistance()
   DebugFlags debug;             ///< layers of Scene::debug to draw
+  /// Draw Scene::debug whatever the layers: what a host put there itself (the viewer's outline
+  /// of the selected body) shows without turning a debug layer on.
+  bool overlay = false;
+};
+
+/// What the last draw did with the tufts.
+struct FrameStats {
+  size_t tufts = 0;           ///< in the scene
+  size_t drawn = 0;           ///< uploaded and drawn (two crossed quads each)
+  size_t frustumCulled = 0;   ///< wholly outside the view frustum
+  size_t distanceCulled = 0;  ///< farther than cullDistance()
+  double cullAndSortMs = 0;   ///< CPU: culling, the front-to-back sort and the upload
 };
 
 class Renderer {
@@ -101,11 +130,24 @@ class Renderer {
   const std::string& lastAssetError() const;
 
   /// The last frame's blurred ambient occlusion (half resolution, grey: 255 = open, 0 = fully
-  /// occluded), or an empty image when that frame had SSAO off. For tests and inspection.
-  Image readAmbientOcclusion();
+  /// occluded), or with `blurred` false the occlusion pass' output before the blur; an empty image
+  /// when that frame had SSAO off. For tests and inspection. Half-resolution pixel (x, y) (top row
+  /// first) stands for full-resolution pixel (2x, 2y + 1) (top row first; an even height).
+  Image readAmbientOcclusion(bool blurred = true);
 
   /// The atlas in use (generated on the first draw).
   const TuftAtlas* atlas() const;
+
+  /// Tufts farther than this from the camera are not drawn (m): where the fog leaves less than
+  /// 1/255 of their colour, sqrt(ln 255) / fogDensity (400 m at the default density), so they
+  /// cannot change an 8-bit pixel (and a 0.6 m tuft there is under a pixel tall at 800 x 600).
+  float cullDistance() const;
+  const FrameStats& lastFrameStats() const;
+
+  /// Every tuft vertex as the tuft vertex shader places it (transform feedback, nothing drawn;
+  /// the ground grid of `scene` uploaded first): per tuft in scene order (no culling), per quad of
+  /// the cross, the corners bottom-left, bottom-right, top-left, top-right; x, y, z in metres.
+  std::vector<std::array<float, 3>> captureTuftCorners(const Scene& scene);
 
  private:
   struct Impl;

@@ -3,11 +3,14 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <climits>
 #include <cmath>
+#include <initializer_list>
 #include <set>
 #include <string>
 
 #include "sim/collision/body_particles.h"
+#include "sim/field/markings.h"
 #include "sim/math/scalar_ops.h"
 #include "sim/scenario/derived.h"
 #include "sim/world/world.h"
@@ -147,6 +150,257 @@ void extractGround(const World<S>& w, const Scenario& scenario, GroundGrid* g) {
   g->revision = nextGroundRevision.fetch_add(1);
 }
 
+/// Floor division (b > 0) for lattice coordinates that may be negative.
+int64_t floorDiv(int64_t a, int64_t b) {
+  const int64_t q = a / b;
+  return (a % b != 0 && a < 0) ? q - 1 : q;
+}
+
+/// FNV-1a over a list of integers (cache and memory keys).
+uint64_t mixKey(uint64_t h, std::initializer_list<int64_t> values) {
+  for (int64_t v : values)
+    for (int b = 0; b < 8; ++b) h = (h ^ uint64_t((v >> (8 * b)) & 0xff)) * 1099511628211ull;
+  return h;
+}
+
+/// The world's football-field markings, built from the scenario exactly as World<S> builds its own
+/// (sim/world/world.cpp): the renderer needs them for the edge ring's lattice tufts.
+template <class S>
+FieldMarkings<S> markingsOf(const Scenario& s) {
+  // The scenario's exact numbers, converted as World<S> converts them (a validated scenario's
+  // values fit S), so a lattice point on a line's edge falls on the same side as in the world.
+  const auto exact = [](const Rational& r) {
+    return ScalarTraits<S>::fromRational(r).value_or(fromD<S>(r.toDouble()));
+  };
+  FieldMarkings<S> m;
+  if (!s.markings.enabled) return m;
+  m.enabled = true;
+  m.centerX = exact(s.markings.centerX);
+  m.centerZ = exact(s.markings.centerZ);
+  m.halfLength = exact(s.markings.length) / S(2);
+  m.halfWidth = exact(s.markings.width) / S(2);
+  m.halfLine = exact(s.markings.lineWidth) / S(2);
+  m.circleRadius = exact(s.markings.centerCircleRadius);
+  return m;
+}
+
+/// The edge ring as the thesis built it (DIGEST §3): rows m = edgeSpacing grass spacings apart
+/// around the simulated window, the tufts of a row one grass spacing apart. The simulation's
+/// EdgeRing holds one coarse cell per m x m patches (which cells are drawn, and where the hole
+/// is); each visible cell becomes the m grass-lattice tufts of the ring row through its centre
+/// patch: along x in the bands beyond the window's -z and +z sides, along z beside its -x and +x
+/// sides, and in a corner cell (as far out in x as in z) an L from its inner edges to its centre,
+/// so every row closes into a square loop. They are the grass lattice's own tufts (position,
+/// rotation, variant, marking, cut): a row that the window reaches shows the same tufts simulated.
+/// Rebuilt only when the ring or the window moves or a cut appears.
+template <class S>
+void extractRing(const World<S>& w, const Scenario& scenario, float halfWidth, float scaleY, Scene* scene) {
+  const EdgeRing<S>& ring = w.edgeRing();
+  RingCache& cache = scene->ring;
+  if (ring.rows <= 0) {
+    cache.tufts.clear();
+    cache.patch.clear();
+    cache.key = 0;
+    return;
+  }
+  const LatticeWindow &cells = ring.cells, &hole = ring.hole;
+  const uint64_t key = mixKey(scenario.seed ^ 0x72696e67ull,
+                              {cells.originI, cells.originJ, cells.sizeI, cells.sizeJ, hole.originI, hole.originJ,
+                               hole.sizeI, hole.sizeJ, hole.fieldI, hole.fieldJ, int64_t(w.cuts().size()),
+                               ring.spacingMultiple, int64_t(scenario.field.atlasVariants)});
+  if (key == cache.key && !cache.tufts.empty()) return;
+  cache.key = key;
+  cache.tufts.clear();
+  cache.patch.clear();
+  const int64_t m = std::max<int64_t>(1, ring.spacingMultiple);
+  // The hole in coarse cells: a in [a0, a1], b in [b0, b1] have their centre patch in the window.
+  const auto firstCell = [m](int64_t patch) { return floorDiv(patch - m / 2 + m - 1, m); };
+  const int64_t a0 = firstCell(hole.originI), a1 = firstCell(hole.endI()) - 1;
+  const int64_t b0 = firstCell(hole.originJ), b1 = firstCell(hole.endJ()) - 1;
+  const GrassLattice<S>& lattice = w.lattice();
+  const FieldMarkings<S> markings = markingsOf<S>(scenario);
+  const double cutTop = std::min<double>(std::max(scenario.bodies.mowerCutHeight.toDouble(), scaleY / 10.0), scaleY);
+  auto emit = [&](int64_t i, int64_t j) {
+    if (i < 0 || j < 0 || i >= hole.fieldI || j >= hole.fieldJ || hole.contains(i, j)) return;
+    S x, z;
+    lattice.rootXZ(i, j, &x, &z);
+    TuftInstance t{};
+    t.x = float(toD(x));
+    t.z = float(toD(z));
+    t.y = float(toD(w.terrain().heightAt(x, z)));
+    const bool cut = w.cuts().count({i, j}) > 0;
+    t.halfWidth = halfWidth;
+    t.topY = t.y + (cut ? float(cutTop) : scaleY);
+    t.angle = float(lattice.rotation(i, j)) * kTurn;
+    t.variant = lattice.variant(i, j);
+    if (markings.onLine(lattice.originX + mulInt(lattice.spacing, i), lattice.originZ + mulInt(lattice.spacing, j)))
+      t.variant = uint8_t(lattice.atlasVariants);
+    t.level = cut ? 3 : 0;
+    cache.tufts.push_back(t);
+    cache.patch.push_back(j * hole.fieldI + i);
+  };
+  for (int64_t b = cells.originJ; b < cells.endJ(); ++b)
+    for (int64_t a = cells.originI; a < cells.endI(); ++a) {
+      if (!ring.visible(a, b)) continue;
+      const int64_t dx = a < a0 ? a0 - a : (a > a1 ? a - a1 : 0);
+      const int64_t dz = b < b0 ? b0 - b : (b > b1 ? b - b1 : 0);
+      const int64_t ic = ring.centrePatchI(a), jc = ring.centrePatchJ(b);
+      if (dz > dx) {  // beyond the -z or +z side: a row along x
+        for (int64_t i = a * m; i < a * m + m; ++i) emit(i, jc);
+      } else if (dx > dz) {  // beside the -x or +x side: a row along z
+        for (int64_t j = b * m; j < b * m + m; ++j) emit(ic, j);
+      } else {  // a corner: from the x row's inner edge to the centre, then on to the z row's
+        const bool right = a > a1, far = b > b1;
+        for (int64_t i = right ? a * m : ic; i <= (right ? ic : a * m + m - 1); ++i) emit(i, jc);
+        for (int64_t j = far ? b * m : jc + 1; j <= (far ? jc - 1 : b * m + m - 1); ++j) emit(ic, j);
+      }
+    }
+}
+
+/// The current footprints of the bodies' primitives (a mesh body: its collision proxies), in a
+/// stable order: the scene's parts, a mesh's proxies in its place.
+std::vector<TrailMemory::Footprint> footprintsOf(const Scene& scene, float margin) {
+  std::vector<TrailMemory::Footprint> out;
+  auto add = [&](const BodyPartDraw& p) {
+    const Mat4& m = p.model;
+    TrailMemory::Footprint f{};
+    f.x = m[12];
+    f.z = m[14];
+    if (p.shape == BodyPartDraw::Shape::Sphere) {
+      // A sphere's model is a rotation times its radius: any column's length is the radius.
+      const float r = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+      f.bottom = m[13] - r;
+      f.disc = true;
+      f.halfA = f.halfB = r + margin;
+      f.axisX[0] = 1, f.axisX[1] = 0;
+    } else {
+      f.bottom = m[13] - (std::fabs(m[1]) + std::fabs(m[5]) + std::fabs(m[9]));  // the box's lowest corner
+      // The box's two most horizontal axes (columns scaled by the half extents) span its footprint.
+      int up = 0;
+      float best = -1;
+      for (int c = 0; c < 3; ++c) {
+        const float* v = &m[size_t(c) * 4];
+        const float len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        const float vertical = len > 0 ? std::fabs(v[1]) / len : 0;
+        if (vertical > best) best = vertical, up = c;
+      }
+      const float* u = &m[size_t((up + 1) % 3) * 4];
+      const float* v = &m[size_t((up + 2) % 3) * 4];
+      const float lu = std::sqrt(u[0] * u[0] + u[2] * u[2]), lv = std::sqrt(v[0] * v[0] + v[2] * v[2]);
+      f.disc = false;
+      f.axisX[0] = lu > 0 ? u[0] / lu : 1;
+      f.axisX[1] = lu > 0 ? u[2] / lu : 0;
+      f.halfA = lu + margin;
+      f.halfB = lv + margin;
+    }
+    out.push_back(f);
+  };
+  for (const BodyPartDraw& p : scene.bodyParts) {
+    if (p.shape != BodyPartDraw::Shape::Mesh) {
+      add(p);
+      continue;
+    }
+    for (uint32_t i = p.firstProxy; i < p.firstProxy + p.proxyCount && i < scene.meshProxies.size(); ++i)
+      add(scene.meshProxies[i]);
+  }
+  return out;
+}
+
+/// Presses every patch under footprint `f` at tick `tick`: its trail lasts until tick +
+/// fadeTicks. Only where the body reaches below the grass top (the terrain under its centre +
+/// the tuft height); a sphere presses the disc of its section at the grass top.
+template <class S>
+void stamp(const World<S>& w, const TrailMemory::Footprint& f, float margin, float scaleY, int64_t tick,
+           TrailMemory* mem) {
+  const float ground = float(toD(w.terrain().heightAt(fromD<S>(f.x), fromD<S>(f.z))));
+  const float top = ground + scaleY;
+  if (f.bottom >= top) return;
+  float halfA = f.halfA, halfB = f.halfB;
+  if (f.disc) {  // the section at the grass top (the whole radius when the centre is below it)
+    const float r = f.halfA - margin, centreY = f.bottom + r, above = std::max(0.0f, centreY - top);
+    halfA = halfB = std::sqrt(std::max(0.0f, r * r - above * above)) + margin;
+  }
+  const GrassLattice<S>& lattice = w.lattice();
+  const double spacing = toD(lattice.spacing), jitter = toD(lattice.jitterAmplitude);
+  const double reach = std::sqrt(double(halfA) * halfA + double(halfB) * halfB) + jitter;
+  const double ox = toD(lattice.originX), oz = toD(lattice.originZ);
+  const int64_t i0 = std::max<int64_t>(0, int64_t(std::floor((f.x - reach - ox) / spacing)));
+  const int64_t i1 = std::min<int64_t>(mem->fieldI - 1, int64_t(std::ceil((f.x + reach - ox) / spacing)));
+  const int64_t j0 = std::max<int64_t>(0, int64_t(std::floor((f.z - reach - oz) / spacing)));
+  const int64_t j1 = std::min<int64_t>(mem->fieldJ - 1, int64_t(std::ceil((f.z + reach - oz) / spacing)));
+  const int32_t until = int32_t(std::min<int64_t>(tick + mem->fadeTicks, INT32_MAX));
+  for (int64_t j = j0; j <= j1; ++j)
+    for (int64_t i = i0; i <= i1; ++i) {
+      S sx, sz;
+      lattice.rootXZ(i, j, &sx, &sz);
+      const float dx = float(toD(sx)) - f.x, dz = float(toD(sz)) - f.z;
+      const float along = dx * f.axisX[0] + dz * f.axisX[1], across = -dx * f.axisX[1] + dz * f.axisX[0];
+      const bool inside =
+          f.disc ? dx * dx + dz * dz <= halfA * halfA : std::fabs(along) <= halfA && std::fabs(across) <= halfB;
+      if (!inside) continue;
+      int32_t& at = mem->fadesAt[size_t(j * mem->fieldI + i)];
+      at = std::max(at, until);
+    }
+}
+
+/// Updates the trail memory with this extraction (see extractScene) and returns nothing; the
+/// caller reads TrailMemory::fadesAt.
+template <class S>
+void updateTrails(const World<S>& w, const Scenario& scenario, float scaleY, Scene* scene) {
+  TrailMemory& mem = scene->trails;
+  const int64_t tick = w.tick();
+  uint64_t key = mixKey(groundKey(scenario) ^ scenario.seed,
+                        {w.lattice().patchesX, w.lattice().patchesZ, int64_t(scenario.bodies.list.size())});
+  for (const char c : scenario.name) key = mixKey(key, {int64_t(c)});
+  if (key != mem.key || tick < mem.tick || mem.fieldI != w.lattice().patchesX || mem.fieldJ != w.lattice().patchesZ) {
+    mem.key = key;
+    mem.tick = -1;
+    mem.fieldI = w.lattice().patchesX;
+    mem.fieldJ = w.lattice().patchesZ;
+    mem.fadesAt.clear();
+    mem.footprints.clear();
+  }
+  mem.fadeTicks = std::max<int64_t>(1, std::llround(kTrailSeconds / scenario.timeStep.toDouble()));
+  // A tuft is pressed when its root lies within this much of the body's footprint: the rods lean
+  // away from the body, so the bent grass reaches a little beyond it (m).
+  const float margin = 0.6f * float(toD(w.lattice().spacing));
+  std::vector<TrailMemory::Footprint> now = footprintsOf(*scene, margin);
+  if (!now.empty() && mem.fadesAt.empty()) mem.fadesAt.assign(size_t(mem.fieldI * mem.fieldJ), 0);
+  const int64_t gap = tick - mem.tick;
+  const bool sweep = mem.tick >= 0 && gap >= 1 && gap <= kTrailSweepTicks && mem.footprints.size() == now.size();
+  const float step = 0.5f * float(toD(w.lattice().spacing));
+  for (size_t p = 0; p < now.size(); ++p) {
+    const TrailMemory::Footprint& f = now[p];
+    const float dist = sweep ? std::hypot(f.x - mem.footprints[p].x, f.z - mem.footprints[p].z) : 0.0f;
+    if (!sweep || dist > kTrailSweepMetres || mem.footprints[p].disc != f.disc) {
+      stamp(w, f, margin, scaleY, tick, &mem);
+      continue;
+    }
+    // The path since the last extraction, a sample every half grass spacing, each pressed at its
+    // own (interpolated) tick, so the trail fades from its old end.
+    const TrailMemory::Footprint& before = mem.footprints[p];
+    const int64_t samples = std::max<int64_t>(1, int64_t(std::ceil(dist / step)));
+    for (int64_t s = 1; s <= samples; ++s) {
+      const float t = float(s) / float(samples);
+      TrailMemory::Footprint g = f;
+      g.x = before.x + (f.x - before.x) * t;
+      g.z = before.z + (f.z - before.z) * t;
+      g.bottom = before.bottom + (f.bottom - before.bottom) * t;
+      stamp(w, g, margin, scaleY, mem.tick + s * gap / samples, &mem);
+    }
+  }
+  mem.footprints = std::move(now);
+  mem.tick = tick;
+}
+
+/// A patch's trail (0..255) at `tick`: how much of kTrailSeconds is left since a body pressed it.
+uint8_t trailAt(const TrailMemory& mem, int64_t patch, int64_t tick) {
+  if (mem.fadesAt.empty() || patch < 0 || size_t(patch) >= mem.fadesAt.size()) return 0;
+  const int64_t left = int64_t(mem.fadesAt[size_t(patch)]) - tick;
+  if (left <= 0) return 0;
+  return uint8_t(std::min<int64_t>(255, (left * 255 + mem.fadeTicks - 1) / mem.fadeTicks));
+}
+
 template <class S>
 void extractTyped(const World<S>& w, const Scenario& scenario, Scene* scene) {
   scene->tick = w.tick();
@@ -173,6 +427,8 @@ void extractTyped(const World<S>& w, const Scenario& scenario, Scene* scene) {
     t.angle = float(p.rotation[k]) * kTurn;
     t.variant = p.variant[k];
     t.level = p.cut[k] ? uint8_t(3) : p.tiltLevel[k];  // thesis §5: mown tufts stay brighter
+    t.heat = 0;
+    t.trail = 0;
   }
   scene->simulatedTufts = n;
   scene->windowOriginI = win.originI;
@@ -183,23 +439,8 @@ void extractTyped(const World<S>& w, const Scenario& scenario, Scene* scene) {
   scene->fieldPatchesZ = win.fieldJ;
 
   // Edge ring (level of detail): static tufts, standing straight.
-  const EdgeRing<S>& ring = w.edgeRing();
-  const std::vector<size_t> cells = ring.visibleCells();
-  const float ringHalfWidth = halfWidth * std::sqrt(float(std::max<int64_t>(1, ring.spacingMultiple)));
-  const double cutTop = std::max(scenario.bodies.mowerCutHeight.toDouble(), scaleY / 10.0);
-  for (const size_t q : cells) {
-    TuftInstance t{};
-    t.x = float(toD(ring.x[q]));
-    t.y = float(toD(ring.y[q]));
-    t.z = float(toD(ring.z[q]));
-    t.halfWidth = ringHalfWidth;
-    t.topY = t.y + (ring.cut[q] ? float(std::min<double>(cutTop, scaleY)) : scaleY);
-    t.tipX = t.tipZ = 0;
-    t.angle = float(ring.rotation[q]) * kTurn;
-    t.variant = ring.variant[q];
-    t.level = ring.cut[q] ? 3 : 0;
-    scene->tufts.push_back(t);
-  }
+  extractRing(w, scenario, halfWidth, scaleY, scene);
+  scene->tufts.insert(scene->tufts.end(), scene->ring.tufts.begin(), scene->ring.tufts.end());
 
   // Bodies: one draw per part; a body with a mesh is one mesh draw, its parts kept as proxies.
   scene->bodyParts.clear();
@@ -246,6 +487,29 @@ void extractTyped(const World<S>& w, const Scenario& scenario, Scene* scene) {
       paint(d, name, body.mower, b);
       target.push_back(d);
     }
+  }
+
+  // Trails: where bodies pressed the grass (render-side memory), and the blade model's trampling.
+  updateTrails(w, scenario, scaleY, scene);
+  const TrailMemory& mem = scene->trails;
+  const ParticleArrays<S>& pa = w.particles();
+  const ParticleGrid& grid = w.particleGrid();
+  const bool trampling = !pa.trample.empty();
+  if (!mem.fadesAt.empty() || trampling) {
+    for (size_t k = 0; k < n; ++k) {
+      const int64_t i = win.latticeColumn(int64_t(k) % win.sizeI), j = win.latticeRow(int64_t(k) / win.sizeI);
+      uint8_t t = trailAt(mem, j * win.fieldI + i, scene->tick);
+      if (trampling) {  // the particle this patch takes its motion from (its lower-left one)
+        const int64_t I = i / grid.k, J = j / grid.k;
+        if (grid.window.contains(I, J)) {
+          const double level = std::clamp(toD(pa.trample[grid.window.storageIndex(I, J)]), 0.0, 1.0);
+          t = std::max(t, uint8_t(std::lround(255.0 * level)));
+        }
+      }
+      scene->tufts[k].trail = t;
+    }
+    for (size_t r = 0; r < scene->ring.patch.size(); ++r)
+      scene->tufts[n + r].trail = trailAt(mem, scene->ring.patch[r], scene->tick);
   }
 
   // Focus: the simulated window (the whole field with the level of detail off).

@@ -17,18 +17,20 @@ struct Observation;
 
 namespace sg::viewer {
 
-/// One tuft quad (thesis §2): a vertical quad whose bottom edge is centred on the root, turned by
-/// `angle` about y; the top edge sits at `topY`, shifted by (tipX, tipZ). 36 bytes, uploaded as is.
+/// One tuft (thesis §2): two vertical quads crossed at 90 degrees about the root, the first turned
+/// by `angle` about y; their top edges sit `topY - y` above their bottom edges, shifted by (tipX,
+/// tipZ). The renderer bends each bottom corner onto the terrain (docs/rendering.md). 36 bytes,
+/// uploaded as is.
 struct TuftInstance {
-  float x, y, z;     ///< root on the ground (m)
-  float halfWidth;   ///< m (scaleXZ; larger for edge-ring tufts)
-  float topY;        ///< m, world height of the top edge
-  float tipX, tipZ;  ///< m, top-edge shift from the root
-  float angle;       ///< radians (rotation / 65536 turns)
-  uint8_t variant;   ///< atlas column: 0..variants-1, variants = the white marking tuft
-  uint8_t level;     ///< atlas row: brightness 0..3 (tilt level; mown tufts are brightest)
-  uint8_t heat = 0;  ///< divergence overlay: 0 = none .. 255 = full scale (applyDivergenceHeat)
-  uint8_t pad = 0;
+  float x, y, z;      ///< root on the ground (m)
+  float halfWidth;    ///< m (scaleXZ)
+  float topY;         ///< m, world height of the top edge
+  float tipX, tipZ;   ///< m, top-edge shift from the root
+  float angle;        ///< radians (rotation / 65536 turns)
+  uint8_t variant;    ///< atlas column: 0..variants-1, variants = the white marking tuft
+  uint8_t level;      ///< atlas row: brightness 0..3 (tilt level; mown tufts are brightest)
+  uint8_t heat = 0;   ///< divergence overlay: 0 = none .. 255 = full scale (applyDivergenceHeat)
+  uint8_t trail = 0;  ///< pressed by a body: 0 = untouched .. 255 = just pressed (drawn flatter, darker)
 };
 
 /// One body part: a unit sphere or a unit cube (-1..1) under `model` (translation, rotation,
@@ -70,6 +72,40 @@ struct GroundGrid {
   uint64_t key = 0;            ///< hash of the terrain and field it was built for
 };
 
+/// How long a body's trail stays visible (s), and how far apart two extractions may be for a
+/// body's path between them to be swept (ticks, m: beyond, only the current footprint presses).
+inline constexpr double kTrailSeconds = 8.0;
+inline constexpr int64_t kTrailSweepTicks = 120;
+inline constexpr float kTrailSweepMetres = 6.0f;
+
+/// Render-side memory of where bodies pressed the grass (extractScene keeps it between frames):
+/// per lattice patch of the field, the tick at which its trail has faded. A pure function of the
+/// sequence of extracted states (no clock), so a frame sequence always draws the same trails.
+struct TrailMemory {
+  uint64_t key = 0;                ///< the scenario it belongs to (another one starts afresh)
+  int64_t tick = -1;               ///< tick of the last extraction (-1: none)
+  int64_t fieldI = 0, fieldJ = 0;  ///< patches of the field (fadesAt is fieldI * fieldJ, row-major)
+  int64_t fadeTicks = 1;           ///< a trail fades from 1 to 0 over this many ticks
+  std::vector<int32_t> fadesAt;    ///< tick at which patch (i, j)'s trail is gone (0: never pressed)
+  /// The body parts' footprints at the last extraction, to sweep each part's path to the next.
+  struct Footprint {
+    float x, z;          ///< centre (m)
+    float axisX[2];      ///< unit horizontal axis of the first half extent
+    float halfA, halfB;  ///< half extents along axisX and its perpendicular (m; a disc: both its radius)
+    float bottom;        ///< lowest point (m)
+    bool disc;           ///< a sphere's section (else a box's rectangle)
+  };
+  std::vector<Footprint> footprints;
+};
+
+/// The edge ring's tufts for one ring and window position (extractScene rebuilds them only when
+/// the window moves or a cut appears).
+struct RingCache {
+  uint64_t key = 0;
+  std::vector<TuftInstance> tufts;
+  std::vector<int64_t> patch;  ///< per tuft: its lattice patch j * fieldPatchesX + i
+};
+
 struct Scene {
   int64_t tick = 0;
   int atlasVariants = 4;
@@ -88,13 +124,23 @@ struct Scene {
   float focusMinX = 0, focusMaxX = 0, focusMinZ = 0, focusMaxZ = 0;
   float groundHeightAtFocus = 0;  ///< terrain height at the focus centre
   float tuftHeight = 1;           ///< scaleY
+  TrailMemory trails;             ///< where bodies pressed the grass (kept between extractions)
+  RingCache ring;                 ///< the edge ring's tufts (kept between extractions)
 };
 
 /// Fills `scene` from the world's current state. The ground grid is rebuilt only when `scene`
 /// holds none for this terrain and field yet (terrain is static). `scenario` must be the world's
-/// (body names and colours, tuft sizes, mower height). Edge-ring tufts are drawn sqrt(edgeSpacing)
-/// times wider than the grass: they stand edgeSpacing spacings apart, and a wider quad keeps the
-/// ring about as dense.
+/// (body names and colours, tuft sizes, mower height).
+///
+/// The edge ring is drawn as the thesis built it: rows `edgeSpacing` grass spacings apart, around
+/// the simulated window, each row a line of the grass lattice's own tufts one grass spacing
+/// apart (a ring cell of EdgeRing gives the row through its centre patch; docs/rendering.md).
+///
+/// Trails: every body part that reaches below the grass top presses the patches under its
+/// footprint, swept along its path since the previous extraction into the same `scene` (at most
+/// kTrailSweepTicks and kTrailSweepMetres apart); a pressed patch's TuftInstance::trail fades
+/// from 255 to 0 over kTrailSeconds. With the blade model's trampling, a trampled particle's
+/// level shows too. An extraction at an earlier tick or of another scenario starts afresh.
 void extractScene(const SimWorld& world, const Scenario& scenario, Scene* scene);
 
 /// Which debug overlay layers to build / draw.
