@@ -77,6 +77,13 @@ TEST(CliTour, RecordTakesRunsFlagsAsVariants) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("both.sgr")));
   const CliResult bad = runCli("record --lod sideways -o " + quote(dir.file("bad.sgr")));
   EXPECT_NE(bad.exitCode, 0) << bad.describe();
+  // A given flag is a value: empty or spaced values are refused, not read as "no flag".
+  for (const std::string flag : {"--interp ''", "--interp ' 2'", "--dt ''", "--interp 7", "--dt 1/0"}) {
+    const CliResult r = runCli("record " + flag + " --ticks 1 -o " + quote(dir.file("flag.sgr")));
+    EXPECT_EQ(r.exitCode, 2) << flag << "\n" << r.describe();
+    EXPECT_TRUE(isOneLine(r.err)) << r.describe();
+    EXPECT_NE(r.err.find(flag.substr(0, flag.find(' '))), std::string::npos) << "names the flag: " << r.err;
+  }
 }
 
 TEST(CliTour, EveryCommandCountsTheSameHashedTicks) {
@@ -99,6 +106,17 @@ TEST(CliTour, EveryCommandCountsTheSameHashedTicks) {
   EXPECT_EQ(compare["reference"].value("hashesChecked", int64_t(-1)), ticks + 1) << compare.dump();
   const CliResult text = runCli("replay " + quote(rec) + " --verify");
   EXPECT_NE(text.out.find("13 of 13 hashed ticks match"), std::string::npos) << text.out;
+  // diff replays only as far as the shorter run: it says how far, and of how many.
+  const std::string shorter = dir.file("short.sgr");
+  ASSERT_EQ(runCli("record " + quote(scenarioPath("thesis-bodies.json")) + " --ticks 6 -o " + quote(shorter)).exitCode,
+            0);
+  const json partial = parseJson(runCli("diff " + quote(rec) + " " + quote(shorter) + " --json"));
+  EXPECT_EQ(partial["a"].value("replayedTo", int64_t(-1)), 6) << partial.dump();
+  EXPECT_EQ(partial["a"].value("hashesChecked", int64_t(-1)), 7) << partial.dump();
+  EXPECT_EQ(partial["a"].value("hashedTicks", int64_t(-1)), ticks + 1) << partial.dump();
+  const CliResult partialText = runCli("diff " + quote(rec) + " " + quote(shorter));
+  EXPECT_NE(partialText.out.find("replay verified to tick 6 (7 of 13 hashed ticks match"), std::string::npos)
+      << partialText.out;
 }
 
 TEST(CliTour, SweepWritesIntoTheCurrentFolderByDefault) {

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "replay/cli/sweep_shard_format.h"
 #include "replay/report/pareto.h"
 #include "tests/cli_support.h"
 #include "tests/test_support.h"
@@ -212,6 +213,81 @@ TEST_F(SweepScaleOut, ADamagedPlanIsOneLineNamingItsJsonPath) {
   const CliResult missing = runCli("sweep --merge " + quote(file("nothing")) + " --out " + quote(file("o")));
   EXPECT_EQ(missing.exitCode, 2);
   EXPECT_NE(missing.err.find("nothing/plan.json: $: expected"), std::string::npos) << missing.err;
+}
+
+TEST_F(SweepScaleOut, WhatAReviewerBrokeStaysFixed) {
+  const std::string plan = quote(file("plan.json"));
+  // An empty --job (`--job "$SLURM_ARRAY_TASK_ID"` outside Slurm) must not become "write a fresh
+  // default plan over the shared one"; nor --plan with --out but no --job.
+  const std::string before = readFile(file("plan.json"));
+  for (const std::string& args :
+       {"--plan " + plan + " --job '' --out " + quote(file("s")), "--plan " + plan + " --out " + quote(file("s")),
+        "--merge '' --out " + quote(file("s")), "--plan '' --job 0 --out " + quote(file("s"))}) {
+    const CliResult r = runCli("sweep " + args);
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.describe();
+    EXPECT_TRUE(isOneLine(r.err)) << r.describe();
+  }
+  EXPECT_EQ(readFile(file("plan.json")), before) << "the plan file was rewritten";
+
+  // A shards folder holding another plan's copy: the job refuses before it runs (the merge would
+  // otherwise refuse every new shard).
+  fs::create_directories(file("mixed"));
+  ASSERT_EQ(runCli("sweep " + std::regex_replace(settings_, std::regex("--seconds 0.2"), "--seconds 0.25") +
+                   " --plan " + quote(file("mixed/plan.json")))
+                .exitCode,
+            0);
+  const CliResult mixed = runCli("sweep --plan " + plan + " --job 0 --out " + quote(file("mixed")));
+  EXPECT_EQ(mixed.exitCode, 2) << mixed.describe();
+  EXPECT_NE(mixed.err.find("shards of two plans in one folder"), std::string::npos) << mixed.err;
+  EXPECT_FALSE(fs::exists(file("mixed/shard-000000.sgs")));
+
+  // A merge needs no scenario file: it runs from another folder, after the inputs changed.
+  runJobs(0, jobs_, "shards");
+  const std::string scenarioB = readFile(file("b.json"));
+  std::ofstream(file("b.json"), std::ios::app) << "\n";
+  TempDir elsewhere;
+  const CliResult away = runCli("sweep --merge " + quote(file("shards")) + " --out results --json", elsewhere.file(""));
+  EXPECT_EQ(away.exitCode, 0) << away.describe();
+  EXPECT_TRUE(fs::exists(elsewhere.file("results/sweep.json")));
+  std::ofstream(file("b.json"), std::ios::trunc) << scenarioB;  // as planned again, for the jobs below
+
+  // A zstd bomb in a reference shard (100 MB of zeros in a few kB): the variant job refuses it by
+  // the payload bound this plan allows (well under a megabyte here), before allocating it.
+  const json header = json::parse(std::string(readFile(file("shards/shard-000000.sgs")).substr(12, [&] {
+    const std::string b = readFile(file("shards/shard-000000.sgs"));
+    return size_t(uint8_t(b[8])) | size_t(uint8_t(b[9])) << 8 | size_t(uint8_t(b[10])) << 16 |
+           size_t(uint8_t(b[11])) << 24;
+  }())));
+  const std::vector<uint8_t> bomb = sweep::shardBytes(header, std::vector<uint8_t>(size_t(100) << 20, 0));
+  ASSERT_LT(bomb.size(), size_t(1) << 20);
+  fs::create_directories(file("bombed"));
+  std::ofstream(file("bombed/shard-000000.sgs"), std::ios::binary)
+      .write(reinterpret_cast<const char*>(bomb.data()), std::streamsize(bomb.size()));
+  fs::copy_file(file("shards/plan.json"), file("bombed/plan.json"));
+  const CliResult bombed = runCli("sweep --plan " + plan + " --job 2 --out " + quote(file("bombed")));
+  EXPECT_EQ(bombed.exitCode, 2) << bombed.describe();
+  EXPECT_NE(bombed.err.find("a zstd payload of a known size within the plan's bounds"), std::string::npos)
+      << bombed.err;
+
+  // Numbers in a forged header (the checksum recomputed) are held to what the plan's runs give.
+  const std::string variant = readFile(file("shards/shard-000003.sgs"));
+  const size_t textBytes = size_t(uint8_t(variant[8])) | size_t(uint8_t(variant[9])) << 8;
+  for (const auto& [key, value] :
+       std::vector<std::pair<std::string, json>>{{"steps", -5}, {"summary.ticks", -1}, {"summary.ticks", 0}}) {
+    json h = json::parse(variant.substr(12, textBytes));
+    if (key == "steps")
+      h["steps"] = value;
+    else
+      h["summary"]["ticks"] = value;
+    fs::remove_all(file("forged"));
+    fs::copy(file("shards"), file("forged"), fs::copy_options::recursive);
+    const std::vector<uint8_t> bytes = sweep::shardBytes(h, {});
+    std::ofstream(file("forged/shard-000003.sgs"), std::ios::binary | std::ios::trunc)
+        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    const CliResult r = merge("forged", "forged-out");
+    EXPECT_EQ(r.exitCode, 2) << key << " = " << value << "\n" << r.describe();
+    EXPECT_NE(r.err.find("shard-000003.sgs: $." + key), std::string::npos) << r.err;
+  }
 }
 
 TEST_F(SweepScaleOut, AJobRunAgainReplacesItsShardAndChangesNoNumber) {

@@ -414,6 +414,20 @@ TEST(ViewerControls, ScreenshotsOfTheNewViewsMatchTheirGoldens) {
   expectGolden(dir.file("ab.png"), "viewer-ab-side.png", 0, 2 * ((640 - 213) / 2));
 }
 
+TEST(ViewerControls, RecordCommandsThatDoNotFitTheStateAreExit2) {
+  if (!onPath("xvfb-run")) GTEST_SKIP() << "xvfb-run is not on PATH";
+  TempDir dir;
+  for (const std::string& text :
+       {std::string("frames 1\nrecord stop\n"),
+        "record start " + dir.file("a.sgr") + "\nframes 1\nrecord start " + dir.file("b.sgr") + "\n"}) {
+    const std::string script = dir.write("state.txt", text);
+    const CliResult v = runViewer("--script " + quote(script) + kWindow);
+    EXPECT_EQ(v.exitCode, 2) << v.describe();
+    EXPECT_TRUE(isOneLine(v.err)) << v.describe();
+    EXPECT_NE(v.err.find("state.txt:"), std::string::npos) << v.err;
+  }
+}
+
 TEST(ViewerControls, BadControlLinesAreOneLineAndExit2) {
   TempDir dir;
   for (const char* line : {"mouse -1 0", "mouse 1", "button middle down", "button left sideways", "tap nokey", "back x",

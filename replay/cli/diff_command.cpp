@@ -29,11 +29,13 @@ struct Side {
   std::unique_ptr<RecordedHashes> hashes;
   int64_t ticksPerStep = 1;  ///< own ticks per common step
   int64_t hashesChecked = 0, firstMismatchTick = -1;
+  int64_t replayedTo = -1;  ///< the last tick replayed (diff stops at the shorter run's end)
   uint64_t expectedHash = 0, actualHash = 0;
   std::optional<SimError> fault;
   Observation obs, heat;
 
   void check(int64_t tick, uint64_t hash) {
+    replayedTo = std::max(replayedTo, tick);
     const std::optional<uint64_t> expected = hashes->at(tick);
     if (!expected) return;
     if (*expected == hash) {
@@ -54,7 +56,9 @@ struct Side {
                         {"truncated", rec->truncated},
                         {"ticksPerStep", ticksPerStep},
                         {"verified", verified()},
-                        {"hashesChecked", hashesChecked}};
+                        {"replayedTo", replayedTo},
+                        {"hashesChecked", hashesChecked},
+                        {"hashedTicks", rec->hashedTicks()}};
     if (firstMismatchTick >= 0) {
       j["firstMismatchTick"] = firstMismatchTick;
       j["expectedHash"] = hex(expectedHash);
@@ -67,8 +71,12 @@ struct Side {
     if (fault) return "the replay FAULTED: " + fault->message();
     if (firstMismatchTick >= 0)
       return "the replay DIFFERS from the recording from tick " + std::to_string(firstMismatchTick);
-    return hashesChecked > 0 ? "replay verified (" + std::to_string(hashesChecked) + " hashed ticks match)"
-                             : "no recorded hashes to verify";
+    if (hashesChecked == 0) return "no recorded hashes to verify";
+    // Replayed only as far as the other run goes: say so, and of how many hashed ticks.
+    if (replayedTo < rec->lastTick())
+      return "replay verified to tick " + std::to_string(replayedTo) + " (" + std::to_string(hashesChecked) + " of " +
+             std::to_string(rec->hashedTicks()) + " hashed ticks match; the rest lies past the other run's end)";
+    return "replay verified (" + std::to_string(hashesChecked) + " hashed ticks match)";
   }
 };
 

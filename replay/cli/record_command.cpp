@@ -69,8 +69,15 @@ int record(const RecordOptions& o) {
     VariantSettings variant;
     for (const std::string& v : o.variants) variant = VariantSettings::parse(v).over(variant);
     VariantSettings flags;
-    for (const auto& [key, value] : o.shorthands)
-      if (!value.empty()) flags = VariantSettings::parse(std::string(key) + "=" + value).over(flags);
+    for (const auto& [key, value] : o.shorthands) {
+      if (value.empty()) continue;  // not given (a given empty value is refused by the parser)
+      try {
+        flags = VariantSettings::parse(std::string(key) + "=" + value).over(flags);
+      } catch (const std::invalid_argument& e) {  // named by the flag the user typed
+        printError("simgrass record: --%s: %s\n", key, e.what());
+        return kExitBadInput;
+      }
+    }
     if (const std::string keys = sharedKeys(flags, variant); !keys.empty())
       throw std::invalid_argument(keys + ": expected each setting once, as a flag or as a --variant, got both");
     variant = variant.over(flags);
@@ -198,19 +205,33 @@ void addRecordCommand(CLI::App& app, int* exitCode) {
   // The same flags as `simgrass run`, each a shorthand for --variant KEY=VALUE.
   o->shorthands = {{"scalar", ""}, {"interp", ""}, {"broadphase", ""}, {"body-broadphase", ""},
                    {"lod", ""},    {"dt", ""},     {"model", ""}};
+  // A flag's value is one word: empty or spaced values would be read as no flag, or split.
+  const CLI::Validator oneWord(
+      [](std::string& v) {
+        return v.empty() || v.find_first_of(" \t\r\n") != std::string::npos
+                   ? std::string("expected one word (no spaces), got '") + v.substr(0, 40) + "'"
+                   : std::string();
+      },
+      "WORD");
   cmd->add_option("--scalar", o->shorthands[0].second, "Scalar type (= --variant scalar=...)")
-      ->check(CLI::IsMember({"fx32", "fx16", "float", "double"}));
-  cmd->add_option("--interp", o->shorthands[1].second, "Interpolation k, 1..4 (= --variant interp=...)");
+      ->check(CLI::IsMember({"fx32", "fx16", "float", "double"}))
+      ->check(oneWord);
+  cmd->add_option("--interp", o->shorthands[1].second, "Interpolation k, 1..4 (= --variant interp=...)")
+      ->check(oneWord);
   cmd->add_option("--broadphase", o->shorthands[2].second, "Particle-vs-body broad phase (= --variant broadphase=...)")
-      ->check(CLI::IsMember({"grid", "brute"}));
+      ->check(CLI::IsMember({"grid", "brute"}))
+      ->check(oneWord);
   cmd->add_option("--body-broadphase", o->shorthands[3].second,
                   "Body-vs-body broad phase (= --variant body-broadphase=...)")
-      ->check(CLI::IsMember({"brute", "sap"}));
+      ->check(CLI::IsMember({"brute", "sap"}))
+      ->check(oneWord);
   cmd->add_option("--lod", o->shorthands[4].second, "Level of detail: off or window (= --variant lod=...)")
-      ->check(CLI::IsMember({"off", "window"}));
-  cmd->add_option("--dt", o->shorthands[5].second, "Time step in s, e.g. 1/120 (= --variant dt=...)");
+      ->check(CLI::IsMember({"off", "window"}))
+      ->check(oneWord);
+  cmd->add_option("--dt", o->shorthands[5].second, "Time step in s, e.g. 1/120 (= --variant dt=...)")->check(oneWord);
   cmd->add_option("--model", o->shorthands[6].second, "Grass model: thesis, pbd or blade (= --variant model=...)")
-      ->check(CLI::IsMember({"thesis", "pbd", "blade"}));
+      ->check(CLI::IsMember({"thesis", "pbd", "blade"}))
+      ->check(oneWord);
   cmd->add_option("--threads", o->threads, "Worker threads (the recording is identical for any count)")
       ->check(CLI::Range(1, 256));
   cmd->add_option("--check-every", o->checkEvery, "Ticks between state hashes (default: 1 up to ~130,000 patches)")

@@ -122,7 +122,7 @@ int mergeShardFolder(const SweepCommandOptions& o) {
   std::string fingerprint, error;
   sweep::Plan plan;
   try {
-    plan = sweep::readPlan(planPath, &fingerprint);
+    plan = sweep::readPlanForMerge(planPath, &fingerprint);
   } catch (const std::exception& e) {
     printError("simgrass sweep: --merge: %s\n", e.what());
     return kExitBadInput;
@@ -140,6 +140,13 @@ int sweepCommand(const SweepCommandOptions& o, const CLI::App& cmd) {
   // The plan holds every setting of a sharded sweep: its jobs and its merge take none.
   static constexpr const char* kRunOptions[] = {"--scenarios", "--seconds",    "--scalars", "--k",       "--dt",
                                                 "--lod",       "--broadphase", "--models",  "--repeats", "--threads"};
+  // Given but empty (`--job "$SLURM_ARRAY_TASK_ID"` outside Slurm): never read as "not given", which
+  // would turn a job into writing a fresh default plan over the shared one.
+  for (const char* name : {"--plan", "--job", "--merge", "--out"})
+    if (cmd.count(name) > 0 && cmd.get_option(name)->as<std::string>().empty()) {
+      printError("simgrass sweep: %s: expected a value, got an empty one\n", name);
+      return kExitBadInput;
+    }
   const bool sharded = !o.job.empty() || !o.merge.empty();
   if (sharded)
     for (const char* name : kRunOptions)
@@ -166,6 +173,12 @@ int sweepCommand(const SweepCommandOptions& o, const CLI::App& cmd) {
   }
   if (!o.merge.empty()) return mergeShardFolder(o);
   if (!o.job.empty()) return runOneJob(o);
+  if (!o.plan.empty() && cmd.count("--out") > 0) {  // a job whose --job was left out
+    printError(
+        "simgrass sweep: --plan, --out: expected --job I to run a job of the plan into --out (--plan alone "
+        "writes the plan and runs nothing)\n");
+    return kExitBadInput;
+  }
   if (!o.plan.empty()) return writePlanFile(o);
   return sweepHere(o);
 }

@@ -144,7 +144,9 @@ std::string Row::settingsText() const {
          " broadphase=" + (*settings.broadphase == ParticleBroadphase::Brute ? "brute" : "grid");
 }
 
-Plan makePlan(const Options& o, bool measureTufts) {
+namespace {
+/// The axes, the reference's step, the common interval and the run length of `o`.
+Plan planTimes(const Options& o) {
   Plan plan;
   plan.options = o;
   plan.axes = parseAxes(o);
@@ -158,6 +160,32 @@ Plan makePlan(const Options& o, bool measureTufts) {
                   double(plan.interval) * plan.refDt.toDouble(), o.seconds);
     throw std::invalid_argument(buf);
   }
+  return plan;
+}
+
+/// One row per variant of every scenario (each scenario's model errors, when known).
+void listRows(Plan& plan) {
+  plan.rows.clear();
+  for (size_t s = 0; s < plan.scenarios.size(); ++s)
+    for (ScalarKind scalar : plan.axes.scalars)
+      for (int k : plan.axes.ks)
+        for (const Rational& dt : plan.axes.dts)
+          for (LodMode lod : plan.axes.lods)
+            for (ParticleBroadphase bp : plan.axes.broadphases) {
+              Row r;
+              r.scenario = s;
+              r.settings.scalar = scalar, r.settings.interpolation = k, r.settings.timeStep = dt;
+              r.settings.lod = lod, r.settings.broadphase = bp;
+              const auto e = plan.scenarios[s].modelError.find(dt.toString());  // measured, if asked
+              if (e != plan.scenarios[s].modelError.end()) r.modelError = e->second;
+              plan.rows.push_back(std::move(r));
+            }
+}
+}  // namespace
+
+Plan makePlan(const Options& o, bool measureTufts, const char* missingFileHint) {
+  Plan plan = planTimes(o);
+  const VariantSettings ref = referenceSettings();
   // Every scenario loads and takes every variant before anything runs. With --models, each
   // scenario is swept once per model, each against its own reference (the same model at the
   // reference settings): the sweep measures each model's discretisation error, not how far two
@@ -168,11 +196,12 @@ Plan makePlan(const Options& o, bool measureTufts) {
       ScenarioRun sc;
       sc.file = file;
       if (file.empty()) throw ScenarioError("--scenarios", "$", "a comma-separated list of scenario files");
-      if (!fs::is_regular_file(file))
-        throw ScenarioError(
-            file, "$",
-            std::string("a scenario file") +
-                (o.scenarios == kDefaultScenarios ? " (run from the repository root or pass --scenarios)" : ""));
+      if (!fs::is_regular_file(file)) {
+        const char* hint = missingFileHint                    ? missingFileHint
+                           : o.scenarios == kDefaultScenarios ? " (run from the repository root or pass --scenarios)"
+                                                              : " (not found)";
+        throw ScenarioError(file, "$", std::string("a scenario file") + hint);
+      }
       Scenario s = loadScenarioFile(file, &sc.files);
       if (model) {
         VariantSettings chosen;
@@ -186,26 +215,23 @@ Plan makePlan(const Options& o, bool measureTufts) {
       ref.applyTo(s);
       rescaleToReferenceTicks(s, ownDt, plan.refDt, file);
       for (ScalarKind scalar : plan.axes.scalars) validateForScalar(s, scalar, physicalMemoryBytes());
+      sc.inputs = {file};
+      for (const std::string& f : filesNamedBy(s, sc.files, fs::path(file).parent_path().string()))
+        sc.inputs.push_back(f);
       sc.reference = std::move(s);
       plan.scenarios.push_back(std::move(sc));
       // One tuft's behaviour and model error, once the scenario is known to be good (a slow
       // model error used to run before a bad time step was refused).
       if (measureTufts) measureTuft(plan, plan.scenarios.size() - 1, &tipsCache);
     }
-  for (size_t s = 0; s < plan.scenarios.size(); ++s)
-    for (ScalarKind scalar : plan.axes.scalars)
-      for (int k : plan.axes.ks)
-        for (const Rational& dt : plan.axes.dts)
-          for (LodMode lod : plan.axes.lods)
-            for (ParticleBroadphase bp : plan.axes.broadphases) {
-              Row r;
-              r.scenario = s;
-              r.settings.scalar = scalar, r.settings.interpolation = k, r.settings.timeStep = dt;
-              r.settings.lod = lod, r.settings.broadphase = bp;
-              const auto e = plan.scenarios[s].modelError.find(dt.toString());  // measured above, if asked
-              if (e != plan.scenarios[s].modelError.end()) r.modelError = e->second;
-              plan.rows.push_back(std::move(r));
-            }
+  listRows(plan);
+  return plan;
+}
+
+Plan planSkeleton(const Options& o, std::vector<ScenarioRun> scenarios) {
+  Plan plan = planTimes(o);
+  plan.scenarios = std::move(scenarios);
+  listRows(plan);
   return plan;
 }
 

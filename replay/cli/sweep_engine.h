@@ -63,6 +63,7 @@ struct ScenarioRun {
   std::map<std::string, ModelError> modelError;
   Scenario reference;  ///< the scenario under the reference settings, script in reference ticks
   std::vector<sgr::EmbeddedFile> files;
+  std::vector<std::string> inputs;  ///< the scenario file and every file it reads (never an output)
   int64_t patches = 0, bodies = 0;
   std::unique_ptr<sgr::Recording> recording;  ///< the reference's inputs
   std::vector<Observation> observed;          ///< the reference at ticks 0, M, 2M, ... (M: the common interval)
@@ -104,8 +105,14 @@ struct Plan {
 /// the rows. With `measureTufts`, also each scenario's one-tuft behaviour and model errors (the
 /// single-process sweep does it here, before anything long runs; a sharded sweep does it in each
 /// scenario's reference job). Throws std::invalid_argument (an option: "--k: expected ...") or
-/// ScenarioError (a scenario file).
-Plan makePlan(const Options& o, bool measureTufts);
+/// ScenarioError (a scenario file). `missingFileHint` follows "expected a scenario file" when one
+/// is not there (a job: "... relative to the folder the plan was written in").
+Plan makePlan(const Options& o, bool measureTufts, const char* missingFileHint = nullptr);
+
+/// The same plan without its scenario files: the axes, times and rows of `o` over `scenarios`
+/// (their file, name, model and inputs only, from a plan file). What a merge needs: it reads
+/// results, it runs nothing. Throws std::invalid_argument for bad options.
+Plan planSkeleton(const Options& o, std::vector<ScenarioRun> scenarios);
 
 /// Scenario s's one-tuft behaviour and model error at every swept dt. The reference blade's run
 /// is the same for every model of a file: `cache` (by file and dt) keeps it between scenarios.

@@ -178,11 +178,7 @@ bool checkOutputs(const Plan& plan, const std::string& out) {
   // No output may replace one of the scenarios it is computed from, nor a file one of them reads
   // (a heightmap, a mesh: `--out o3` once wrote the plot o3/h-body.png over scenario h's heightmap).
   std::vector<std::string> inputs;
-  for (const ScenarioRun& sc : scenarios) {
-    inputs.push_back(sc.file);
-    for (const std::string& f : filesNamedBy(sc.reference, sc.files, fs::path(sc.file).parent_path().string()))
-      inputs.push_back(f);
-  }
+  for (const ScenarioRun& sc : scenarios) inputs.insert(inputs.end(), sc.inputs.begin(), sc.inputs.end());
   auto overwritesScenario = [&](const std::string& output) {
     return overwritesInput("sweep", "--out", output, inputs);
   };

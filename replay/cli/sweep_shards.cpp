@@ -115,15 +115,19 @@ Shard readShard(const std::string& path, uint64_t maxPayload, bool withPayload =
 }
 
 /// The most a reference payload of this plan can hold (a damaged size field cannot ask for more).
-uint64_t maxPayloadBytes(const Plan& plan) {
-  uint64_t most = 0;
-  for (const ScenarioRun& sc : plan.scenarios) {
-    const uint64_t patches = uint64_t(sc.reference.field.patchesX) * uint64_t(sc.reference.field.patchesZ);
-    const uint64_t states = uint64_t(plan.ticks / plan.interval + 1);
-    const uint64_t bodies = uint64_t(kMaxBodies);
-    most = std::max(most, states * (48 + 8 * (3 * patches + 7 * bodies) + 40));
-  }
-  return most + InputLimits::kRecordingBytes;
+/// The most scenario s's reference payload can hold: its observations (three doubles a patch and
+/// seven a body, at every compared time) and its recording (the scenario text and files, an
+/// input chunk a tick, a chunk per scripted command), twice over. A size field claiming more is
+/// refused before anything is allocated (a forged zstd frame cannot make a job zero-fill 17 GB).
+uint64_t maxPayloadBytes(const Plan& plan, size_t s) {
+  const ScenarioRun& sc = plan.scenarios[s];
+  const uint64_t patches = uint64_t(sc.reference.field.patchesX) * uint64_t(sc.reference.field.patchesZ);
+  const uint64_t states = uint64_t(plan.ticks / plan.interval + 1);
+  const uint64_t observations = states * (40 + 8 * (3 * patches + 7 * uint64_t(kMaxBodies) + 5));
+  uint64_t recording = (uint64_t(64) << 10) + sc.reference.text.size() + uint64_t(plan.ticks) * 128 +
+                       uint64_t(sc.reference.script.size()) * 64;
+  for (const sgr::EmbeddedFile& f : sc.files) recording += f.name.size() + f.bytes.size() + 64;
+  return 2 * (observations + recording) + 16;
 }
 
 json summaryFields(const DivergenceSummary& s) {
@@ -138,18 +142,36 @@ json summaryFields(const DivergenceSummary& s) {
           {"firstHashTick", s.firstHashTick}};
 }
 
-DivergenceSummary summaryFrom(const json& j, const std::string& file) {
+/// A count or tick from a shard, within [lo, hi].
+int64_t ranged(const json& j, const char* key, const std::string& file, const std::string& at, int64_t lo, int64_t hi) {
+  const int64_t v = field<int64_t>(j, key, file, at);
+  if (v < lo || v > hi)
+    fail(file, at + "." + key,
+         "a value from " + std::to_string(lo) + " to " + std::to_string(hi) + ", got " + std::to_string(v));
+  return v;
+}
+
+/// A length or angle from a shard: its bits, a value >= 0 or NaN (a measure of a faulted run).
+double measure(const json& j, const char* key, const std::string& file, const std::string& at) {
+  const double v = fromBits(field<uint64_t>(j, key, file, at));
+  if (!(v >= 0) && !std::isnan(v)) fail(file, at + "." + key, "a measure >= 0 (or NaN)");
+  return v;
+}
+
+/// The summary a variant's shard holds, every field within what this plan's runs can give.
+DivergenceSummary summaryFrom(const json& j, const std::string& file, const Plan& plan) {
   const std::string at = "$.summary";
+  const int64_t states = plan.ticks / plan.interval + 1;
   DivergenceSummary s;
-  s.ticks = field<int64_t>(j, "ticks", file, at);
-  s.tipMax = fromBits(field<uint64_t>(j, "tipMax", file, at));
-  s.tipMaxTick = field<int64_t>(j, "tipMaxTick", file, at);
-  s.tipSumSquares = fromBits(field<uint64_t>(j, "tipSumSquares", file, at));
-  s.bodyPosMax = fromBits(field<uint64_t>(j, "bodyPosMax", file, at));
-  s.bodyAngleMax = fromBits(field<uint64_t>(j, "bodyAngleMax", file, at));
-  s.contactDeltaMax = field<int64_t>(j, "contactDeltaMax", file, at);
-  s.firstObservedTick = field<int64_t>(j, "firstObservedTick", file, at);
-  s.firstHashTick = field<int64_t>(j, "firstHashTick", file, at);
+  s.ticks = ranged(j, "ticks", file, at, 0, states);
+  s.tipMax = measure(j, "tipMax", file, at);
+  s.tipMaxTick = ranged(j, "tipMaxTick", file, at, -1, plan.ticks);
+  s.tipSumSquares = measure(j, "tipSumSquares", file, at);
+  s.bodyPosMax = measure(j, "bodyPosMax", file, at);
+  s.bodyAngleMax = measure(j, "bodyAngleMax", file, at);
+  s.contactDeltaMax = ranged(j, "contactDeltaMax", file, at, 0, int64_t(1) << 32);
+  s.firstObservedTick = ranged(j, "firstObservedTick", file, at, -1, plan.ticks);
+  s.firstHashTick = ranged(j, "firstHashTick", file, at, -1, plan.ticks);
   return s;
 }
 
@@ -159,9 +181,10 @@ json modelErrorJson(const ModelError& e) { return {bitsOf(e.tipRms), bitsOf(e.ti
 void takeReference(Plan& plan, size_t s, const Shard& shard, const std::string& file, bool withObservations) {
   ScenarioRun& sc = plan.scenarios[s];
   const json& h = shard.header;
-  sc.patches = field<int64_t>(h, "patches", file, "$");
-  sc.bodies = field<int64_t>(h, "bodies", file, "$");
-  sc.statesCompared = field<int64_t>(h, "statesCompared", file, "$");
+  sc.patches = ranged(h, "patches", file, "$", 0, int64_t(1) << 40);
+  sc.bodies = ranged(h, "bodies", file, "$", 0, kMaxBodies);
+  const int64_t states = plan.ticks / plan.interval + 1;
+  sc.statesCompared = ranged(h, "statesCompared", file, "$", states, states);
   const json& b = h.value("behaviour", json());
   sc.behaviour.swayStart = fromBits(field<uint64_t>(b, "swayStart", file, "$.behaviour"));
   sc.behaviour.swayLate = fromBits(field<uint64_t>(b, "swayLate", file, "$.behaviour"));
@@ -253,10 +276,15 @@ bool writePlan(const Plan& plan, const std::string& path) {
     }
     jobs.push_back(std::move(job));
   }
+  json scenarios = json::array();  // what a merge needs of them (it reads no scenario file)
+  for (const ScenarioRun& sc : plan.scenarios)
+    scenarios.push_back(
+        {{"file", sc.file}, {"name", sc.name}, {"model", grassModelName(sc.model)}, {"inputs", sc.inputs}});
   const json doc = {{"format", kPlanFormat},
                     {"build", buildId()},
                     {"fingerprint", fingerprintOf(plan)},
                     {"options", optionsJson(plan.options)},
+                    {"scenarios", std::move(scenarios)},
                     {"references", {0, referenceJobs(plan) - 1}},
                     {"variants", {referenceJobs(plan), jobCount(plan) - 1}},
                     {"jobs", std::move(jobs)}};
@@ -268,19 +296,69 @@ bool writePlan(const Plan& plan, const std::string& path) {
   return true;
 }
 
-Plan readPlan(const std::string& path, std::string* fingerprint) {
+namespace {
+/// A plan file's JSON, its format and build checked.
+json planDocument(const std::string& path) {
   std::string text, expected;
   if (!readInputFile(path, kPlanBytes, &text, &expected)) fail(path, "$", expected);
-  const json doc = json::parse(text, nullptr, false);
+  json doc = json::parse(text, nullptr, false);
   if (!doc.is_object()) fail(path, "$", "a sweep plan (JSON, written by simgrass sweep --plan)");
   if (doc.value("format", std::string()) != kPlanFormat) fail(path, "$.format", std::string("'") + kPlanFormat + "'");
   const std::string build = field<std::string>(doc, "build", path, "$");
   if (build != buildId())
     fail(path, "$.build", "a plan of this build ('" + buildId() + "'), got '" + build.substr(0, 80) + "'");
+  return doc;
+}
+}  // namespace
+
+Plan readPlanForMerge(const std::string& path, std::string* fingerprint) {
+  const json doc = planDocument(path);
+  const Options o = optionsFrom(doc.value("options", json()), path);
+  *fingerprint = field<std::string>(doc, "fingerprint", path, "$");
+  const json& list = doc.value("scenarios", json());
+  if (!list.is_array() || list.empty() || list.size() > 100000)
+    fail(path, "$.scenarios", "the plan's scenarios (a non-empty list)");
+  std::vector<ScenarioRun> scenarios;
+  for (size_t k = 0; k < list.size(); ++k) {
+    const std::string at = "$.scenarios[" + std::to_string(k) + "]";
+    ScenarioRun sc;
+    sc.file = field<std::string>(list[k], "file", path, at);
+    sc.name = field<std::string>(list[k], "name", path, at);
+    const std::string model = field<std::string>(list[k], "model", path, at);
+    try {
+      sc.model = *VariantSettings::parse("model=" + model).model;
+    } catch (const std::invalid_argument&) {
+      fail(path, at + ".model", "thesis, pbd or blade");
+    }
+    const json& inputs = list[k].value("inputs", json());
+    if (!inputs.is_array() || inputs.size() > 10000) fail(path, at + ".inputs", "a list of file names");
+    for (const json& f : inputs) {
+      if (!f.is_string()) fail(path, at + ".inputs", "a list of file names");
+      sc.inputs.push_back(f.get<std::string>());
+    }
+    scenarios.push_back(std::move(sc));
+  }
+  Plan plan;
+  try {
+    plan = planSkeleton(o, std::move(scenarios));
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(path + ": $.options: " + e.what());
+  }
+  // The scenarios as the options list them (under each model): one entry each, in that order.
+  const size_t expected = splitList(o.scenarios).size() * plan.axes.models.size();
+  if (plan.scenarios.size() != expected)
+    fail(path, "$.scenarios",
+         std::to_string(expected) + " scenarios (the options' files under their models), got " +
+             std::to_string(plan.scenarios.size()));
+  return plan;
+}
+
+Plan readPlan(const std::string& path, std::string* fingerprint) {
+  const json doc = planDocument(path);
   const Options o = optionsFrom(doc.value("options", json()), path);
   Plan plan;
   try {
-    plan = makePlan(o, false);
+    plan = makePlan(o, false, " (paths in a plan are relative to the folder it was written in: run jobs there)");
   } catch (const std::exception& e) {  // ScenarioError, std::invalid_argument
     throw std::runtime_error(path + ": $.options: " + e.what());
   }
@@ -334,6 +412,23 @@ int runJob(Plan& plan, const std::string& fingerprint, int64_t job, const std::s
                dir.c_str());
     return kExitBadInput;
   }
+  // One folder, one plan: a copy of another plan there would make the merge refuse every shard.
+  const std::string planCopy = (fs::path(dir) / kPlanCopy).string();
+  if (fs::exists(planCopy, ec) || fs::is_symlink(planCopy, ec)) {
+    std::string theirs;
+    try {
+      (void)readPlanForMerge(planCopy, &theirs);
+    } catch (const std::exception&) {
+      theirs = "";  // not a plan of this build: named below
+    }
+    if (theirs != fingerprint) {
+      printError(
+          "simgrass sweep: %s: expected this plan's copy (fingerprint %s), got %s: shards of two plans "
+          "in one folder (give each plan a folder of its own)\n",
+          planCopy.c_str(), fingerprint.c_str(), theirs.empty() ? "something else" : ("plan " + theirs).c_str());
+      return kExitBadInput;
+    }
+  }
   json header = {{"format", kShardFormat}, {"fingerprint", fingerprint}, {"job", job}, {"name", jobName(plan, job)}};
   std::vector<uint8_t> payload;
   if (job < referenceJobs(plan)) {
@@ -365,11 +460,12 @@ int runJob(Plan& plan, const std::string& fingerprint, int64_t job, const std::s
     const int64_t refJob = int64_t(row.scenario);
     try {  // the reference of its scenario, from its shard: computed once, by its own job
       const std::string refFile = shardPath(dir, refJob);
-      const Shard ref = readShard(refFile, maxPayloadBytes(plan));
+      const Shard ref = readShard(refFile, maxPayloadBytes(plan, row.scenario));
       if (shardJob(plan, fingerprint, ref, refFile) != refJob) fail(refFile, "$.job", "job " + std::to_string(refJob));
       takeReference(plan, row.scenario, ref, refFile, true);
     } catch (const std::exception& e) {
-      printError("simgrass sweep: job %" PRId64 " needs the reference shard of job %" PRId64 " (run it first): %s\n",
+      printError("simgrass sweep: job %" PRId64 " needs the reference shard of job %" PRId64
+                 " (run that job first, or again): %s\n",
                  job, refJob, e.what());
       return kExitBadInput;
     }
@@ -385,8 +481,7 @@ int runJob(Plan& plan, const std::string& fingerprint, int64_t job, const std::s
     header["fault"] = row.fault;
     header["summary"] = summaryFields(row.summary);
   }
-  // The plan beside the shards, for the merge (the same bytes from every job: a rewrite is harmless).
-  const std::string planCopy = (fs::path(dir) / kPlanCopy).string();
+  // The plan beside the shards, for the merge (checked above: missing, or this plan's).
   std::string error;
   try {
     const std::vector<uint8_t> bytes = shardBytes(header, payload);
@@ -415,12 +510,11 @@ bool mergeShards(Plan& plan, const std::string& fingerprint, const std::string& 
   }
   std::sort(files.begin(), files.end());
   std::vector<std::string> fileOf(size_t(jobCount(plan)));
-  const uint64_t maxPayload = maxPayloadBytes(plan);
   try {
     for (const std::string& file : files) {
       // Headers first (a variant's result is its header); a reference's observations are not
       // needed by the report and stay in its payload.
-      const Shard s = readShard(file, maxPayload, false);
+      const Shard s = readShard(file, 0, false);  // headers only: the payloads stay unread
       const int64_t job = shardJob(plan, fingerprint, s, file);
       std::string& seen = fileOf[size_t(job)];
       if (!seen.empty()) {
@@ -434,16 +528,25 @@ bool mergeShards(Plan& plan, const std::string& fingerprint, const std::string& 
         continue;
       }
       Row& row = plan.rows[size_t(job - referenceJobs(plan))];
-      row.steps = field<int64_t>(s.header, "steps", file, "$");
+      // A variant steps at most dt_ref / dt_min = 1/240 / 1e-5 own ticks per reference tick.
+      row.steps = ranged(s.header, "steps", file, "$", 0, plan.ticks * 420);
       row.fault = field<std::string>(s.header, "fault", file, "$");
       row.runMs.clear();
       const json& runMs = s.header.value("runMs", json());
-      if (!runMs.is_array() || runMs.size() > 100) fail(file, "$.runMs", "the runs' times (at most 100)");
+      if (!runMs.is_array() || runMs.size() > size_t(plan.options.repeats))
+        fail(file, "$.runMs", "the times of at most " + std::to_string(plan.options.repeats) + " runs");
       for (const json& v : runMs) {
-        if (!v.is_number_unsigned()) fail(file, "$.runMs", "the runs' times");
-        row.runMs.push_back(fromBits(v.get<uint64_t>()));
+        const double ms = v.is_number_unsigned() ? fromBits(v.get<uint64_t>()) : -1;
+        if (!(ms >= 0 && std::isfinite(ms))) fail(file, "$.runMs", "the runs' times (finite, >= 0 ms)");
+        row.runMs.push_back(ms);
       }
-      row.summary = summaryFrom(s.header.value("summary", json()), file);
+      row.summary = summaryFrom(s.header.value("summary", json()), file, plan);
+      // A run that ended compared every common time and stepped; a faulted one may stop anywhere.
+      if (row.fault.empty() &&
+          (row.summary.ticks != plan.ticks / plan.interval + 1 || row.steps == 0 || row.runMs.empty()))
+        fail(file, "$.summary.ticks",
+             "a complete run's " + std::to_string(plan.ticks / plan.interval + 1) +
+                 " compared times, its steps and its times");
     }
   } catch (const std::runtime_error& e) {
     *error = e.what();

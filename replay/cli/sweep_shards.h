@@ -44,6 +44,11 @@ bool writePlan(const Plan& plan, const std::string& path);
 /// JSON path and what was expected, or that the build or the inputs are not the plan's.
 Plan readPlan(const std::string& path, std::string* fingerprint);
 
+/// What a merge needs of a plan file: its options, scenarios (file, name, model, inputs) and
+/// fingerprint, without reading a scenario file (the shards hold the results; the inputs may
+/// since have changed or be elsewhere). Throws std::runtime_error with one line.
+Plan readPlanForMerge(const std::string& path, std::string* fingerprint);
+
 /// The job index: `text` is a number, or "env": SLURM_ARRAY_TASK_ID, JOB_COMPLETION_INDEX
 /// (Kubernetes indexed Jobs) or PARALLEL_SEQ - 1 (GNU parallel's {#}), the first one set. Plus
 /// `offset`. Throws std::invalid_argument with one line.

@@ -177,10 +177,12 @@ void App::handleKeyPress(int key, int mods) {
       openNeighbourScene(key == GLFW_KEY_PAGE_DOWN ? 1 : -1);
       return;
     case GLFW_KEY_SPACE:
-      if (play_)
+      if (play_) {
         play_->playing = !play_->playing;
-      else
+      } else {
         paused_ = !paused_;
+        if (!paused_) status_.clear();  // "at tick T of N" from a step back no longer holds
+      }
       return;
     case GLFW_KEY_PERIOD:
       if (play_) {

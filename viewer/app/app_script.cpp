@@ -99,11 +99,13 @@ int App::runCommand(const ScriptCommand& c) {
       return kGoOn;
     case K::RecordStart:
       if (play_) return bad("record start: a playback is not recorded again");
+      if (live_->recorder) return bad("record start: expected no recording running, got one to " + live_->recordPath);
       if (const std::string in = inputNamed(c.path); !in.empty())
         return bad(c.path + ": expected an output file other than the input " + in);
       if (!live_->startRecording(c.path, &error)) return failWith(kExitFailure, error);
       return kGoOn;
     case K::RecordStop:
+      if (!live_->recorder) return bad("record stop: expected a recording running, got none");
       if (!live_->stopRecording(&error)) return failWith(kExitFailure, error);
       return kGoOn;
     case K::Screenshot:
@@ -117,6 +119,7 @@ int App::runCommand(const ScriptCommand& c) {
     case K::Pause:
       if (!play_) {  // live: resume / pause the session
         paused_ = c.kind == K::Pause;
+        if (!paused_) status_.clear();
         return kGoOn;
       }
       play_->playing = c.kind == K::Play;

@@ -154,7 +154,7 @@ void App::panelLive() {
   if (!ImGui::CollapsingHeader("Live", ImGuiTreeNodeFlags_DefaultOpen)) return;
   ImGui::Text("tick %" PRId64 " of %" PRId64 " in the history%s", live_->world->tick(), live_->historyEnd(),
               paused_ ? ", paused" : "");
-  if (ImGui::Button(paused_ ? "Resume (Space)" : "Pause (Space)")) paused_ = !paused_;
+  if (ImGui::Button(paused_ ? "Resume (Space)" : "Pause (Space)")) handleKeyPress(GLFW_KEY_SPACE, 0);
   ImGui::SameLine();
   if (ImGui::Button("Back (,)")) stepLiveBack(1);
   ImGui::SameLine();

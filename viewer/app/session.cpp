@@ -171,7 +171,9 @@ bool Session::startRecording(const std::string& path, std::string* error) {
     while (!snapshots_.empty() && snapshots_.back().first > now) snapshots_.pop_back();
     return true;
   } catch (const std::exception& e) {
-    *error = path + ": " + e.what();
+    // The writer's messages name the file already ("x.sgr: cannot create ..."): not twice.
+    const std::string what = e.what();
+    *error = what.rfind(path + ":", 0) == 0 ? what : path + ": " + what;
     return false;
   }
 }

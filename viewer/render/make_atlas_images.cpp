@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
     const sg::viewer::Image* image;
   } outputs[] = {{"tuft-atlas.png", &atlas.image}, {"ground-texture.png", &ground}};
   for (const auto& out : outputs) {
-    const std::string path = outDir + "/" + out.name;
+    const std::string path = (std::filesystem::path(outDir) / out.name).string();
     std::string error;
     if (!sg::viewer::writePng(path, *out.image, &error)) {
       std::fprintf(stderr, "simgrass-atlas: %s\n", error.c_str());

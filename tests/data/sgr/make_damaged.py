@@ -285,7 +285,7 @@ def build(data):
         {"outcome": "error", "offset": inpt[0] + 8 + body_at, "message": "a body index >= 0, got -1"})
     add("inpt-command-kind.sgr", "inpt-field",
         replace_chunk(data, inpt, frame(b"INPT", ip[:body_at + 4] + b"\x09" + ip[body_at + 5:])),
-        {"outcome": "error", "offset": inpt[0] + 8 + body_at + 4, "message": "a command kind 0..7, got 9"})
+        {"outcome": "error", "offset": inpt[0] + 8 + body_at + 4, "message": "a command kind 0..8, got 9"})
     add("inpt-command-count.sgr", "inpt-field",
         replace_chunk(data, inpt, frame(b"INPT", ip[:9] + struct.pack("<I", 0x10000000) + ip[13:])),
         {"outcome": "error", "offset": inpt[0] + 8 + 9, "message": "a command count that fits the INPT chunk"})
