@@ -17,6 +17,10 @@
 
 namespace sg::sweep {
 
+/// Throws std::runtime_error with the one line every sweep input error has:
+/// "file: where: expected what".
+[[noreturn]] void failInput(const std::string& file, const std::string& where, const std::string& what);
+
 struct Shard {
   nlohmann::json header;
   std::vector<uint8_t> payload;  ///< decompressed (empty when not asked for)

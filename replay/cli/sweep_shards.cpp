@@ -63,24 +63,19 @@ json optionsJson(const Options& o) {
           {"threads", o.threads}};
 }
 
-/// A one-line error about `file`: "file: where: expected what".
-[[noreturn]] void fail(const std::string& file, const std::string& where, const std::string& what) {
-  throw std::runtime_error(file + ": " + where + ": expected " + what);
-}
-
 template <class T>
 T field(const json& j, const char* key, const std::string& file, const std::string& at) {
   const std::string where = at + "." + key;
-  if (!j.is_object() || !j.contains(key)) fail(file, where, "a value (missing)");
+  if (!j.is_object() || !j.contains(key)) failInput(file, where, "a value (missing)");
   const json& v = j[key];
   if constexpr (std::is_same_v<T, std::string>) {
-    if (!v.is_string()) fail(file, where, "a string");
+    if (!v.is_string()) failInput(file, where, "a string");
   } else if constexpr (std::is_same_v<T, bool>) {
-    if (!v.is_boolean()) fail(file, where, "true or false");
+    if (!v.is_boolean()) failInput(file, where, "true or false");
   } else if constexpr (std::is_floating_point_v<T>) {
-    if (!v.is_number()) fail(file, where, "a number");
+    if (!v.is_number()) failInput(file, where, "a number");
   } else {
-    if (!v.is_number_integer()) fail(file, where, "an integer");
+    if (!v.is_number_integer()) failInput(file, where, "an integer");
   }
   return v.get<T>();
 }
@@ -98,9 +93,9 @@ Options optionsFrom(const json& j, const std::string& file) {
   o.seconds = field<double>(j, "seconds", file, at);
   o.repeats = int(field<int64_t>(j, "repeats", file, at));
   o.threads = int(field<int64_t>(j, "threads", file, at));
-  if (!(o.seconds >= 1e-3 && o.seconds <= 3600)) fail(file, at + ".seconds", "1e-3 to 3600 s");
-  if (o.repeats < 1 || o.repeats > 100) fail(file, at + ".repeats", "1 to 100");
-  if (o.threads < 1 || o.threads > 256) fail(file, at + ".threads", "1 to 256");
+  if (!(o.seconds >= 1e-3 && o.seconds <= 3600)) failInput(file, at + ".seconds", "1e-3 to 3600 s");
+  if (o.repeats < 1 || o.repeats > 100) failInput(file, at + ".repeats", "1 to 100");
+  if (o.threads < 1 || o.threads > 256) failInput(file, at + ".threads", "1 to 256");
   return o;
 }
 
@@ -110,7 +105,7 @@ Options optionsFrom(const json& j, const std::string& file) {
 Shard readShard(const std::string& path, uint64_t maxPayload, bool withPayload = true) {
   std::vector<uint8_t> b;
   std::string expected;
-  if (!readInputFile(path, InputLimits::kRecordingBytes, &b, &expected)) fail(path, "byte 0", expected);
+  if (!readInputFile(path, InputLimits::kRecordingBytes, &b, &expected)) failInput(path, "byte 0", expected);
   return parseShard(b, path, maxPayload, withPayload);
 }
 
@@ -146,15 +141,15 @@ json summaryFields(const DivergenceSummary& s) {
 int64_t ranged(const json& j, const char* key, const std::string& file, const std::string& at, int64_t lo, int64_t hi) {
   const int64_t v = field<int64_t>(j, key, file, at);
   if (v < lo || v > hi)
-    fail(file, at + "." + key,
-         "a value from " + std::to_string(lo) + " to " + std::to_string(hi) + ", got " + std::to_string(v));
+    failInput(file, at + "." + key,
+              "a value from " + std::to_string(lo) + " to " + std::to_string(hi) + ", got " + std::to_string(v));
   return v;
 }
 
 /// A length or angle from a shard: its bits, a value >= 0 or NaN (a measure of a faulted run).
 double measure(const json& j, const char* key, const std::string& file, const std::string& at) {
   const double v = fromBits(field<uint64_t>(j, key, file, at));
-  if (!(v >= 0) && !std::isnan(v)) fail(file, at + "." + key, "a measure >= 0 (or NaN)");
+  if (!(v >= 0) && !std::isnan(v)) failInput(file, at + "." + key, "a measure >= 0 (or NaN)");
   return v;
 }
 
@@ -195,9 +190,9 @@ void takeReference(Plan& plan, size_t s, const Shard& shard, const std::string& 
   for (const Rational& dt : plan.axes.dts) {
     const std::string key = dt.toString();
     if (!m.is_object() || !m.contains(key) || !m[key].is_array() || m[key].size() != 3)
-      fail(file, "$.modelError." + key, "three numbers (the model error at this dt)");
+      failInput(file, "$.modelError." + key, "three numbers (the model error at this dt)");
     for (const json& v : m[key])
-      if (!v.is_number_unsigned()) fail(file, "$.modelError." + key, "three numbers (the model error at this dt)");
+      if (!v.is_number_unsigned()) failInput(file, "$.modelError." + key, "three numbers (the model error at this dt)");
     sc.modelError[key] = {fromBits(m[key][0].get<uint64_t>()), fromBits(m[key][1].get<uint64_t>()),
                           fromBits(m[key][2].get<uint64_t>())};
   }
@@ -209,18 +204,18 @@ void takeReference(Plan& plan, size_t s, const Shard& shard, const std::string& 
 /// Checks that a shard belongs to this plan and is the job its header says; returns the job.
 int64_t shardJob(const Plan& plan, const std::string& fingerprint, const Shard& s, const std::string& file) {
   if (s.header.value("format", std::string()) != kShardFormat)
-    fail(file, "$.format", std::string("'") + kShardFormat + "'");
+    failInput(file, "$.format", std::string("'") + kShardFormat + "'");
   const std::string theirs = s.header.value("fingerprint", std::string());
   if (theirs != fingerprint)
-    fail(file, "$.fingerprint",
-         "a shard of this plan (fingerprint " + fingerprint + "), got one of plan '" + theirs.substr(0, 40) + "'");
+    failInput(file, "$.fingerprint",
+              "a shard of this plan (fingerprint " + fingerprint + "), got one of plan '" + theirs.substr(0, 40) + "'");
   const int64_t job = field<int64_t>(s.header, "job", file, "$");
   if (job < 0 || job >= jobCount(plan))
-    fail(file, "$.job", "a job from 0 to " + std::to_string(jobCount(plan) - 1) + ", got " + std::to_string(job));
+    failInput(file, "$.job", "a job from 0 to " + std::to_string(jobCount(plan) - 1) + ", got " + std::to_string(job));
   const std::string kind = field<std::string>(s.header, "kind", file, "$");
   if (kind != (job < referenceJobs(plan) ? "reference" : "variant"))
-    fail(file, "$.kind",
-         std::string(job < referenceJobs(plan) ? "reference" : "variant") + " for job " + std::to_string(job));
+    failInput(file, "$.kind",
+              std::string(job < referenceJobs(plan) ? "reference" : "variant") + " for job " + std::to_string(job));
   return job;
 }
 }  // namespace
@@ -300,13 +295,14 @@ namespace {
 /// A plan file's JSON, its format and build checked.
 json planDocument(const std::string& path) {
   std::string text, expected;
-  if (!readInputFile(path, kPlanBytes, &text, &expected)) fail(path, "$", expected);
+  if (!readInputFile(path, kPlanBytes, &text, &expected)) failInput(path, "$", expected);
   json doc = json::parse(text, nullptr, false);
-  if (!doc.is_object()) fail(path, "$", "a sweep plan (JSON, written by simgrass sweep --plan)");
-  if (doc.value("format", std::string()) != kPlanFormat) fail(path, "$.format", std::string("'") + kPlanFormat + "'");
+  if (!doc.is_object()) failInput(path, "$", "a sweep plan (JSON, written by simgrass sweep --plan)");
+  if (doc.value("format", std::string()) != kPlanFormat)
+    failInput(path, "$.format", std::string("'") + kPlanFormat + "'");
   const std::string build = field<std::string>(doc, "build", path, "$");
   if (build != buildId())
-    fail(path, "$.build", "a plan of this build ('" + buildId() + "'), got '" + build.substr(0, 80) + "'");
+    failInput(path, "$.build", "a plan of this build ('" + buildId() + "'), got '" + build.substr(0, 80) + "'");
   return doc;
 }
 }  // namespace
@@ -317,7 +313,7 @@ Plan readPlanForMerge(const std::string& path, std::string* fingerprint) {
   *fingerprint = field<std::string>(doc, "fingerprint", path, "$");
   const json& list = doc.value("scenarios", json());
   if (!list.is_array() || list.empty() || list.size() > 100000)
-    fail(path, "$.scenarios", "the plan's scenarios (a non-empty list)");
+    failInput(path, "$.scenarios", "the plan's scenarios (a non-empty list)");
   std::vector<ScenarioRun> scenarios;
   for (size_t k = 0; k < list.size(); ++k) {
     const std::string at = "$.scenarios[" + std::to_string(k) + "]";
@@ -328,12 +324,12 @@ Plan readPlanForMerge(const std::string& path, std::string* fingerprint) {
     try {
       sc.model = *VariantSettings::parse("model=" + model).model;
     } catch (const std::invalid_argument&) {
-      fail(path, at + ".model", "thesis, pbd or blade");
+      failInput(path, at + ".model", "thesis, pbd or blade");
     }
     const json& inputs = list[k].value("inputs", json());
-    if (!inputs.is_array() || inputs.size() > 10000) fail(path, at + ".inputs", "a list of file names");
+    if (!inputs.is_array() || inputs.size() > 10000) failInput(path, at + ".inputs", "a list of file names");
     for (const json& f : inputs) {
-      if (!f.is_string()) fail(path, at + ".inputs", "a list of file names");
+      if (!f.is_string()) failInput(path, at + ".inputs", "a list of file names");
       sc.inputs.push_back(f.get<std::string>());
     }
     scenarios.push_back(std::move(sc));
@@ -347,9 +343,9 @@ Plan readPlanForMerge(const std::string& path, std::string* fingerprint) {
   // The scenarios as the options list them (under each model): one entry each, in that order.
   const size_t expected = splitList(o.scenarios).size() * plan.axes.models.size();
   if (plan.scenarios.size() != expected)
-    fail(path, "$.scenarios",
-         std::to_string(expected) + " scenarios (the options' files under their models), got " +
-             std::to_string(plan.scenarios.size()));
+    failInput(path, "$.scenarios",
+              std::to_string(expected) + " scenarios (the options' files under their models), got " +
+                  std::to_string(plan.scenarios.size()));
   return plan;
 }
 
@@ -365,9 +361,9 @@ Plan readPlan(const std::string& path, std::string* fingerprint) {
   const std::string want = field<std::string>(doc, "fingerprint", path, "$");
   *fingerprint = fingerprintOf(plan);
   if (want != *fingerprint)
-    fail(path, "$.fingerprint",
-         "the inputs the plan was made from (fingerprint " + want.substr(0, 40) + "), got " + *fingerprint +
-             ": a scenario or a file it reads changed since");
+    failInput(path, "$.fingerprint",
+              "the inputs the plan was made from (fingerprint " + want.substr(0, 40) + "), got " + *fingerprint +
+                  ": a scenario or a file it reads changed since");
   return plan;
 }
 
@@ -461,7 +457,8 @@ int runJob(Plan& plan, const std::string& fingerprint, int64_t job, const std::s
     try {  // the reference of its scenario, from its shard: computed once, by its own job
       const std::string refFile = shardPath(dir, refJob);
       const Shard ref = readShard(refFile, maxPayloadBytes(plan, row.scenario));
-      if (shardJob(plan, fingerprint, ref, refFile) != refJob) fail(refFile, "$.job", "job " + std::to_string(refJob));
+      if (shardJob(plan, fingerprint, ref, refFile) != refJob)
+        failInput(refFile, "$.job", "job " + std::to_string(refJob));
       takeReference(plan, row.scenario, ref, refFile, true);
     } catch (const std::exception& e) {
       printError("simgrass sweep: job %" PRId64 " needs the reference shard of job %" PRId64
@@ -534,19 +531,19 @@ bool mergeShards(Plan& plan, const std::string& fingerprint, const std::string& 
       row.runMs.clear();
       const json& runMs = s.header.value("runMs", json());
       if (!runMs.is_array() || runMs.size() > size_t(plan.options.repeats))
-        fail(file, "$.runMs", "the times of at most " + std::to_string(plan.options.repeats) + " runs");
+        failInput(file, "$.runMs", "the times of at most " + std::to_string(plan.options.repeats) + " runs");
       for (const json& v : runMs) {
         const double ms = v.is_number_unsigned() ? fromBits(v.get<uint64_t>()) : -1;
-        if (!(ms >= 0 && std::isfinite(ms))) fail(file, "$.runMs", "the runs' times (finite, >= 0 ms)");
+        if (!(ms >= 0 && std::isfinite(ms))) failInput(file, "$.runMs", "the runs' times (finite, >= 0 ms)");
         row.runMs.push_back(ms);
       }
       row.summary = summaryFrom(s.header.value("summary", json()), file, plan);
       // A run that ended compared every common time and stepped; a faulted one may stop anywhere.
       if (row.fault.empty() &&
           (row.summary.ticks != plan.ticks / plan.interval + 1 || row.steps == 0 || row.runMs.empty()))
-        fail(file, "$.summary.ticks",
-             "a complete run's " + std::to_string(plan.ticks / plan.interval + 1) +
-                 " compared times, its steps and its times");
+        failInput(file, "$.summary.ticks",
+                  "a complete run's " + std::to_string(plan.ticks / plan.interval + 1) +
+                      " compared times, its steps and its times");
     }
   } catch (const std::runtime_error& e) {
     *error = e.what();
