@@ -237,6 +237,8 @@ const std::vector<BadCase> kValueCases = {
     // field
     {"SpacingZero", R"({"field": {"spacing": 0}})", "$.field.spacing", "positive"},
     {"ContactHertzZero", R"({"bodies": {"contactHertz": 0}})", "$.bodies.contactHertz", "positive"},
+    {"TipContactUnknown", R"({"bodies": {"tipContact": "stick"}})", "$.bodies.tipContact",
+     "one of \"push\", \"hold\", got \"stick\""},
     {"ContactHertzNegative", R"({"bodies": {"contactHertz": -60}})", "$.bodies.contactHertz", "positive"},
     {"SpacingNegative", R"({"field": {"spacing": -0.25}})", "$.field.spacing", "positive"},
     {"SpacingNegativeFraction", R"({"field": {"spacing": "-1/4"}})", "$.field.spacing", "positive"},

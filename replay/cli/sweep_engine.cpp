@@ -239,7 +239,7 @@ void measureTuft(Plan& plan, size_t s, std::map<std::string, std::vector<std::ar
   ScenarioRun& sc = plan.scenarios[s];
   sc.behaviour = measureModelBehaviour(sc.own);
   for (const Rational& dt : plan.axes.dts) {
-    ModelError e{NAN, NAN, 0};
+    ModelError e{NAN, NAN, 0, NAN, NAN, {NAN, NAN}};
     try {
       const std::string key = sc.file + '\n' + dt.toString();
       auto cached = cache->find(key);

@@ -154,7 +154,9 @@ nlohmann::json rowJson(const Row& r, const std::string& scenario, GrassModel mod
           {"pareto_body", r.paretoBody},
           {"model_error_rms_m", r.modelError.tipRms},
           {"model_error_max_m", r.modelError.tipMax},
-          {"pareto_model", r.paretoModel}};
+          {"pareto_model", r.paretoModel},
+          {"model_error_body_rms_m", r.modelError.bodyRms},
+          {"model_error_body_max_m", r.modelError.bodyMax}};
 }
 
 /// The plots' base names: the scenario's slug, numbered when two scenarios share one.
@@ -209,13 +211,13 @@ int writeReport(const Plan& plan, const std::string& out, bool json) {
   const std::string csvHeader =
       "scenario,scalar,k,dt,dt_s,lod,broadphase,steps,ms_per_tick,ms_per_simulated_second,tip_rms_m,tip_max_m,"
       "body_pos_max_m,body_angle_max_rad,first_divergent_time,states_compared,status,pareto,pareto_tip_max,pareto_body,"
-      "model_error_rms_m,model_error_max_m,pareto_model";
+      "model_error_rms_m,model_error_max_m,pareto_model,model_error_body_rms_m,model_error_body_max_m";
   const double refDtS = refDt.toDouble();
   if (!writeCsv("sweep", csvPath, csvHeader, [&](std::FILE* f) {
         for (const Row& r : rows) {
           const nlohmann::json j = rowJson(r, scenarios[r.scenario].name, scenarios[r.scenario].model, refDtS);
           std::fprintf(
-              f, "%s,%s,%d,%s,%s,%s,%s,%" PRId64 ",%s,%s,%s,%s,%s,%s,%s,%" PRId64 ",%s,%d,%d,%d,%s,%s,%d\n",
+              f, "%s,%s,%d,%s,%s,%s,%s,%" PRId64 ",%s,%s,%s,%s,%s,%s,%s,%" PRId64 ",%s,%d,%d,%d,%s,%s,%d,%s,%s\n",
               csvField(scenarios[r.scenario].name).c_str(), scalarName(*r.settings.scalar), *r.settings.interpolation,
               r.settings.timeStep->toString().c_str(), csvNumber(r.dtSeconds()).c_str(),
               j["lod"].get<std::string>().c_str(), j["broadphase"].get<std::string>().c_str(), r.steps,
@@ -224,7 +226,8 @@ int writeReport(const Plan& plan, const std::string& out, bool json) {
               csvNumber(r.summary.bodyPosMax).c_str(), csvNumber(r.summary.bodyAngleMax).c_str(),
               csvNumber(j["first_divergent_time"].get<double>()).c_str(), r.summary.ticks, csvField(r.status()).c_str(),
               r.pareto ? 1 : 0, r.paretoTipMax ? 1 : 0, r.paretoBody ? 1 : 0, csvNumber(r.modelError.tipRms).c_str(),
-              csvNumber(r.modelError.tipMax).c_str(), r.paretoModel ? 1 : 0);
+              csvNumber(r.modelError.tipMax).c_str(), r.paretoModel ? 1 : 0, csvNumber(r.modelError.bodyRms).c_str(),
+              csvNumber(r.modelError.bodyMax).c_str());
         }
       }))
     return kExitBadInput;

@@ -170,7 +170,9 @@ DivergenceSummary summaryFrom(const json& j, const std::string& file, const Plan
   return s;
 }
 
-json modelErrorJson(const ModelError& e) { return {bitsOf(e.tipRms), bitsOf(e.tipMax), bitsOf(e.seconds)}; }
+json modelErrorJson(const ModelError& e) {
+  return {bitsOf(e.tipRms), bitsOf(e.tipMax), bitsOf(e.seconds), bitsOf(e.bodyRms), bitsOf(e.bodyMax)};
+}
 
 /// The reference results of scenario `s` from its shard's header and payload.
 void takeReference(Plan& plan, size_t s, const Shard& shard, const std::string& file, bool withObservations) {
@@ -189,12 +191,13 @@ void takeReference(Plan& plan, size_t s, const Shard& shard, const std::string& 
   const json& m = h.value("modelError", json());
   for (const Rational& dt : plan.axes.dts) {
     const std::string key = dt.toString();
-    if (!m.is_object() || !m.contains(key) || !m[key].is_array() || m[key].size() != 3)
-      failInput(file, "$.modelError." + key, "three numbers (the model error at this dt)");
+    const char* expected = "five numbers (the model error at this dt)";
+    if (!m.is_object() || !m.contains(key) || !m[key].is_array() || m[key].size() != 5)
+      failInput(file, "$.modelError." + key, expected);
     for (const json& v : m[key])
-      if (!v.is_number_unsigned()) failInput(file, "$.modelError." + key, "three numbers (the model error at this dt)");
-    sc.modelError[key] = {fromBits(m[key][0].get<uint64_t>()), fromBits(m[key][1].get<uint64_t>()),
-                          fromBits(m[key][2].get<uint64_t>())};
+      if (!v.is_number_unsigned()) failInput(file, "$.modelError." + key, expected);
+    const auto number = [&](size_t k) { return fromBits(m[key][k].get<uint64_t>()); };
+    sc.modelError[key] = {number(0), number(1), number(2), number(3), number(4)};
   }
   for (Row& r : plan.rows)
     if (r.scenario == s) r.modelError = sc.modelError.at(r.settings.timeStep->toString());

@@ -84,13 +84,39 @@ void ReferenceBlade::bendTo(double angle) {
   }
 }
 
-void ReferenceBlade::advance(double seconds, const std::array<double, 3>& windForce) {
+void ReferenceBlade::advance(double seconds, const std::array<double, 3>& windForce, const ReferenceBall* ball) {
   const int steps = std::max(1, int(std::ceil(seconds / h_ - 1e-9)));
   const double h = seconds / steps;
-  for (int s = 0; s < steps; ++s) substepOnce(h, windForce);
+  for (int s = 0; s < steps; ++s) {
+    if (!ball) {
+      substepOnce(h, windForce, nullptr);
+      continue;
+    }
+    const double u = double(s + 1) / steps;  // the ball where it is at the substep's end
+    std::array<double, 4> at{0, 0, 0, ball->radius};
+    for (size_t c = 0; c < 3; ++c) at[c] = ball->from[c] + (ball->to[c] - ball->from[c]) * u;
+    substepOnce(h, windForce, &at);
+  }
 }
 
-void ReferenceBlade::substepOnce(double h, const std::array<double, 3>& windForce) {
+double ReferenceBlade::pushOutOf(const std::array<double, 4>& ball) {
+  double deepest = 0;
+  for (size_t i = 0; i < size_t(n_); ++i) {
+    const double dx = x_[i] - ball[0], dy = y_[i] - ball[1], dz = z_[i] - ball[2];
+    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+    if (d >= ball[3]) continue;
+    deepest = std::max(deepest, ball[3] - d);
+    if (!(d > 0)) {  // at the centre: straight up
+      y_[i] = ball[1] + ball[3];
+      continue;
+    }
+    const double scale = ball[3] / d;
+    x_[i] = ball[0] + dx * scale, y_[i] = ball[1] + dy * scale, z_[i] = ball[2] + dz * scale;
+  }
+  return deepest;
+}
+
+void ReferenceBlade::substepOnce(double h, const std::array<double, 3>& windForce, const std::array<double, 4>* ball) {
   const size_t n = size_t(n_);
   // Forces: weight and wind on every node.
   for (size_t i = 0; i < n; ++i) {
@@ -134,9 +160,9 @@ void ReferenceBlade::substepOnce(double h, const std::array<double, 3>& windForc
     z_[i] += h * vz_[i];
   }
   // Mass-weighted projection, root to tip, until every segment is within 1e-6 of its length
-  // (4 sweeps or fewer under a scenario's forces; at most 64).
+  // and no node is inside the ball (4 sweeps or fewer under a scenario's forces; at most 64).
   for (int sweep = 0; sweep < 64; ++sweep) {
-    double worst = 0;
+    double worst = ball ? pushOutOf(*ball) : 0;
     for (size_t j = 0; j < n; ++j) {
       const double ax = j ? x_[j - 1] : 0, ay = j ? y_[j - 1] : 0, az = j ? z_[j - 1] : 0;
       const double dx = x_[j] - ax, dy = y_[j] - ay, dz = z_[j] - az;

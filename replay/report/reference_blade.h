@@ -17,6 +17,12 @@
 // to 1e-3 (forces per unit mass far beyond a scenario's) each node is put back at its length root to
 // tip, so a tip is never farther than L (1 + 1e-3) from its root; v = (x - x_before)/h. h is chosen from
 // the chain's highest linearised mode, h omega_max <= 0.05.
+//
+// A body (the model error with bodies): a sphere moved kinematically (it is not pushed back: the
+// grass's push on a body is the share m_particle / (m + m_particle) of the models, ~0 for a heavy
+// one). Each projection sweep also moves every node inside it out to its surface along the
+// radius, so the contact is a position constraint like the lengths: its velocity (the body stops
+// the node, or carries it along) comes from v = (x - x_before)/h.
 #pragma once
 
 #include <array>
@@ -24,6 +30,13 @@
 #include <vector>
 
 namespace sg {
+
+/// A sphere moving in a straight line over one advance(): its centre goes from `from` to `to`
+/// (m, relative to the root) at a uniform speed.
+struct ReferenceBall {
+  std::array<double, 3> from{0, 0, 0}, to{0, 0, 0};
+  double radius = 0;  ///< m
+};
 
 struct ReferenceBladeParams {
   double length = 1;          ///< m
@@ -42,8 +55,9 @@ class ReferenceBlade {
   explicit ReferenceBlade(const ReferenceBladeParams& p);
 
   /// Advances `seconds` (in whole substeps of at most substep()) under a total wind force
-  /// (N, spread evenly over the nodes).
-  void advance(double seconds, const std::array<double, 3>& windForce);
+  /// (N, spread evenly over the nodes), against `ball` where given (its centre at each substep's
+  /// end interpolated between from and to).
+  void advance(double seconds, const std::array<double, 3>& windForce, const ReferenceBall* ball = nullptr);
 
   /// Puts the blade straight at `angle` (rad) from upright toward +x, at rest.
   void bendTo(double angle);
@@ -55,7 +69,10 @@ class ReferenceBlade {
   double highestMode() const { return omegaMax_; }    ///< rad/s, linearised
 
  private:
-  void substepOnce(double h, const std::array<double, 3>& windForce);
+  void substepOnce(double h, const std::array<double, 3>& windForce, const std::array<double, 4>* ball);
+  /// Moves the nodes inside the ball (centre, radius) out to its surface along its radius; returns
+  /// the deepest a node was (0: none inside).
+  double pushOutOf(const std::array<double, 4>& ball);
 
   int n_ = 0;
   double length_ = 0, segment_ = 0, nodeMass_ = 0, gravity_ = 0;

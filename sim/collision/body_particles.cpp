@@ -90,11 +90,10 @@ namespace {
 
 /// Pushes one particle out of a sphere or box part; returns whether it was inside. Called only for
 /// particles within the part's candidateReach (withinReach).
-/// Model blade, nearest-face normal: the box face nearest the particle among those its blade can
-/// reach out through (exit point within `reach` of its root); the nearest face when none can. A
-/// blade under a box dropped on it cannot reach the top face just above its tip: it goes out
-/// through a side or is pressed flat through the bottom, instead of being pushed up and pulled back
-/// in by its rod every tick.
+/// Held tips (model blade; thesis and pbd with tipContact hold), nearest-face normal: the box face nearest the particle
+/// among those its blade can reach out through (exit point within `reach` of its root); the nearest face when none can.
+/// A blade under a box dropped on it cannot reach the top face just above its tip: it goes out through a side or is
+/// pressed flat through the bottom, instead of being pushed up and pulled back in by its rod every tick.
 template <class S>
 int reachableFaceAxis(const ParticleArrays<S>& pa, size_t i, const Vec3<S>& local, const Vec3<S>& h,
                       const Pose<S>& pose, S share, S reach, S* gap, S* side) {
@@ -119,7 +118,7 @@ int reachableFaceAxis(const ParticleArrays<S>& pa, size_t i, const Vec3<S>& loca
   return axis;
 }
 
-/// `reach`: model blade, the rod length (0: thesis and pbd, the nearest face whatever it is).
+/// `reach`: tips held as contacts (holdTips), the rod length (0: the nearest face whatever it is).
 template <class S>
 bool pushOut(ParticleArrays<S>& pa, size_t i, const GrassPusher<S>& pusher, BoxParticleNormal boxNormal, S reach) {
   const Vec3<S> p(pa.px[i], pa.py[i], pa.pz[i]);
@@ -158,7 +157,7 @@ bool pushOut(ParticleArrays<S>& pa, size_t i, const GrassPusher<S>& pusher, BoxP
   return true;
 }
 
-/// Model blade: a push straight down (an `up` box normal, a ball centred over the tip) moves the
+/// Held tips: a push straight down (an `up` box normal, a ball centred over the tip) moves the
 /// tip toward its root; the rod's projection would put it back where it was, inside the body, and
 /// store the undoing as an upward velocity. The blade bends instead: the tip keeps the height the
 /// push gave it and goes to the rod's length sideways, in the direction it leans (standing
@@ -186,7 +185,7 @@ void bendUnderVerticalPush(ParticleArrays<S>& pa, size_t i, const Vec3<S>& bodyC
   pa.pz[i] = az + leanZ * reach;
 }
 
-/// Model blade: a pushed tip goes straight back to its rod's length (above its root) here, not in
+/// Held tips: a pushed tip goes straight back to its rod's length (above its root) here, not in
 /// the next tick's projection, which would turn the whole push into velocity (PBD's v += correction
 /// / dt): a box pushing a tip 0.3 m out through a face sent it off at 18 m/s.
 template <class S>
@@ -201,12 +200,12 @@ void backToTheRod(ParticleArrays<S>& pa, size_t i, S rod) {
   pa.pz[i] = az + ez * scale;
 }
 
-/// Model blade, after a push moved particle i from `before`: a vertical push bends the blade
+/// Held tips (holdTips), after a push moved particle i from `before`: a vertical push bends the blade
 /// (bendUnderVerticalPush), any other goes back to the rod (backToTheRod), the velocity into the body goes (the body
 /// stops the tip, as a contact would: the spring would otherwise build an inward velocity tick after tick), and the tip
 /// is trampled.
 template <class S>
-void bladeContact(ParticleArrays<S>& pa, size_t i, const Vec3<S>& before, const Vec3<S>& bodyCentre, S rod) {
+void holdTip(ParticleArrays<S>& pa, size_t i, const Vec3<S>& before, const Vec3<S>& bodyCentre, S rod) {
   if (!pa.trample.empty()) pa.trample[i] = S(1);
   if (pa.px[i] == before.x() && pa.pz[i] == before.z())
     bendUnderVerticalPush(pa, i, bodyCentre, rod);
@@ -297,9 +296,9 @@ int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid
   // One particle pushed out of a part it is within reach of; false where the stage must stop.
   const auto pushInside = [&](size_t i, const GrassPusher<S>& pusher) {
     const Vec3<S> before(pa.px[i], pa.py[i], pa.pz[i]);
-    if (!pushOut(pa, i, pusher, s.boxNormal, s.bladeContact ? s.rodLength : S(0))) return true;
+    if (!pushOut(pa, i, pusher, s.boxNormal, s.holdTips ? s.rodLength : S(0))) return true;
     if (pushedPerBody) ++pushedPerBody[pusher.body];
-    if (s.bladeContact) bladeContact(pa, i, before, pusher.pose.position, s.rodLength);
+    if (s.holdTips) holdTip(pa, i, before, pusher.pose.position, s.rodLength);
     return !T::faultPending() && T::isFinite(pa.px[i]) && T::isFinite(pa.py[i]) && T::isFinite(pa.pz[i]);
   };
   // Storage rows [rowBegin, rowEnd): each holds one lattice row of the window. Per particle the

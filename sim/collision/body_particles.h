@@ -45,11 +45,14 @@ struct BodyParticleSettings {
   /// The rows' height marks (grass_candidates.h), fixed-point only. They change no bits; off only
   /// in the tests that check exactly that.
   bool heightMarks = true;
-  /// Model blade: a pushed tip also loses the velocity that carried it into the body (its spring
-  /// would otherwise build an inward velocity tick after tick), and is trampled when the particles
-  /// carry a trample level (sim/particles/blade.h). Thesis and pbd move the position only.
-  bool bladeContact = false;
-  S rodLength{};  ///< L (m), for bladeContact
+  /// A pushed tip is held as a contact would (model blade always; thesis and pbd with
+  /// `"tipContact": "hold"`): it goes back to its rod's length at once, a vertical push bends it,
+  /// it loses the velocity that carried it into the body (a spring or the rod's projection would
+  /// otherwise turn the push into velocity, tick after tick), and it is trampled when the particles
+  /// carry a trample level (sim/particles/blade.h). Otherwise (`"push"`, the thesis): the position
+  /// moves, nothing else.
+  bool holdTips = false;
+  S rodLength{};  ///< L (m), for holdTips
 };
 
 /// Candidate ranges for every body part, in (body, part) order.

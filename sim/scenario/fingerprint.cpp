@@ -69,6 +69,8 @@ uint64_t scenarioFingerprint(const Scenario& s) {
       putInts(h, {0x636f6e7461637448});  // "contactH"
       putRational(h, b.contactHertz);
     }
+    if (b.tipContact == TipContact::Hold && s.particles.model != GrassModel::Blade)  // the blade always holds
+      putInts(h, {0x746970486f6c64});                                                // "tipHold"
     putRational(h, b.mowerCutHeight);
     for (const BodySpec& body : b.list) {
       h.put(uint64_t(body.name.size()));  // length first: names cannot run into what follows

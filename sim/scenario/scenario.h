@@ -41,6 +41,11 @@ enum class ShapeType : uint8_t { Sphere, Box };
 enum class ParticleBroadphase : uint8_t { Grid, Brute };
 /// Which body pairs the body-body stage tests (results are identical).
 enum class BodyBroadphase : uint8_t { Brute, SweepAndPrune };
+/// What a body's push does to a grass tip (models thesis and pbd; the blade model always holds).
+enum class TipContact : uint8_t {
+  Push,  ///< thesis: the position moves out of the body, nothing else
+  Hold,  ///< as a contact: back to its rod's length, a vertical push bends it, no velocity into the body
+};
 /// The push direction for a particle inside a box.
 enum class BoxParticleNormal : uint8_t {
   Up,           ///< thesis: constant (0, 1, 0); the particle is pushed down, towards the ground
@@ -199,6 +204,9 @@ struct Scenario {
     ParticleBroadphase particleBroadphase = ParticleBroadphase::Grid;
     BodyBroadphase bodyBroadphase = BodyBroadphase::Brute;
     BoxParticleNormal boxParticleNormal = BoxParticleNormal::Up;
+    /// Models thesis and pbd (docs/grass-models.md "Bodies in every model"): the thesis' push
+    /// leaves tips inside a body that rests on them; `hold` keeps them out.
+    TipContact tipContact = TipContact::Push;
     Rational mowerCutHeight{1, 5};  ///< m above the ground: where a mower's blade cuts the tufts
     /// Grass drag on bodies, N s/m per tuft pushed this tick (0: off, the thesis model): each
     /// pushed tuft resists the body's motion, v *= 1 - min(1, drag * tufts * dt / m).

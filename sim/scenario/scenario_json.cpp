@@ -506,7 +506,7 @@ void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
   const std::string p = "$.bodies";
   r.object(j, p,
            {"gravity", "substeps", "velocityIterations", "positionIterations", "contactHertz", "particleBroadphase",
-            "bodyBroadphase", "boxParticleNormal", "mowerCutHeight", "grassDrag", "list"});
+            "bodyBroadphase", "boxParticleNormal", "tipContact", "mowerCutHeight", "grassDrag", "list"});
   if (j.contains("contactHertz")) b.contactHertz = r.positive(j["contactHertz"], p + ".contactHertz");
   if (j.contains("grassDrag")) b.grassDrag = r.nonNegative(j["grassDrag"], p + ".grassDrag");
   if (j.contains("mowerCutHeight")) b.mowerCutHeight = r.nonNegative(j["mowerCutHeight"], p + ".mowerCutHeight");
@@ -528,6 +528,9 @@ void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
     b.boxParticleNormal =
         r.choice<BoxParticleNormal>(j["boxParticleNormal"], p + ".boxParticleNormal",
                                     {{"up", BoxParticleNormal::Up}, {"nearest-face", BoxParticleNormal::NearestFace}});
+  if (j.contains("tipContact"))
+    b.tipContact = r.choice<TipContact>(j["tipContact"], p + ".tipContact",
+                                        {{"push", TipContact::Push}, {"hold", TipContact::Hold}});
   if (j.contains("list")) {
     const json& l = j["list"];
     if (!l.is_array() || l.size() > 1024) r.failGot(p + ".list", "an array of at most 1024 bodies", l);

@@ -167,7 +167,7 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   ticksToSleep_ = std::max<int32_t>(1, int32_t(*div(exact(settings::kSleepTime), s.timeStep)->roundToInt64()));
   bodyParticle_.boxNormal = s.bodies.boxParticleNormal;
   bodyParticle_.broadphase = s.bodies.particleBroadphase;
-  bodyParticle_.bladeContact = model_ == GrassModel::Blade;
+  bodyParticle_.holdTips = model_ == GrassModel::Blade || s.bodies.tipContact == TipContact::Hold;
   bodyParticle_.rodLength = particleConsts_.rodLength;
   bodyParticle_.particleInvMass = toS<S>(c.invMass);
   S largest(0);
