@@ -192,5 +192,35 @@ TEST(ModelError, TheBladeModelIsClosestToTheReference) {
   for (int m = 0; m < 3; ++m) EXPECT_GT(through[m], 2 * over[2]) << m;
 }
 
+// From a review: a long-decimal rod length made the ball's exact volume overflow, and the whole
+// model error (wind and press included) went NaN without a word; the scenario's grass drag slowed
+// the model's ball and not the reference's. Now the ball scales with L rounded to 2^-20 m, keeps
+// its speed whatever the drag, and where it cannot be made (L beyond 1e9 m) only the body figures
+// are NaN, with the reason.
+TEST(ModelError, TheBallsNeverTakeTheOtherRunsDown) {
+  const auto tuft = [](const char* length) {
+    Scenario s = test::singleTuft(GrassModel::Thesis);
+    VariantSettings::parse("model=blade").applyTo(s);
+    std::string error;
+    s.particles.constraintLength = *Rational::parse(length, &error);
+    return s;
+  };
+  const ModelError decimals = measureModelError(tuft("0.1234567890123"), Rational{1, 60});
+  EXPECT_TRUE(std::isfinite(decimals.tipRms) && std::isfinite(decimals.bodyRms)) << decimals.bodyError;
+  EXPECT_TRUE(decimals.bodyError.empty()) << decimals.bodyError;
+  EXPECT_NEAR(decimals.seconds, 60.0, 1e-9);
+
+  Scenario dragged = tuft("1");
+  const ModelError plain = measureModelError(dragged, Rational{1, 60});
+  dragged.bodies.grassDrag = Rational{2000, 1};
+  EXPECT_EQ(measureModelError(dragged, Rational{1, 60}).bodyRms, plain.bodyRms);
+
+  const ModelError huge = measureModelError(tuft("2e9"), Rational{1, 60});
+  EXPECT_TRUE(std::isfinite(huge.tipRms));
+  EXPECT_TRUE(std::isnan(huge.bodyRms) && std::isnan(huge.passRms[0]));
+  EXPECT_NE(huge.bodyError.find("$.particles.constraintLength"), std::string::npos) << huge.bodyError;
+  EXPECT_NEAR(huge.seconds, 40.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace sg

@@ -103,7 +103,8 @@ plot::ScatterPlot errorPlot(const ScenarioRun& sc, const std::vector<const Row*>
   p.notes.push_back(buf);
   p.notes.push_back(modelError
                         ? "Model error: one tuft's tip RMS against the reference blade (8 segments, double; "
-                          "docs/grass-models.md), 30 s of wind and a press; it depends on the model and dt only."
+                          "docs/grass-models.md): 30 s of wind, a press, two balls passing; it depends on the "
+                          "model, dt and tipContact only."
                         : "Reference: double, k = 1, dt = 1/240, LOD off. Pareto points are ringed and labelled: "
                           "scalar, k, dt, win = LOD window.");
   std::snprintf(buf, sizeof buf, "Cost: median of %d run%s, %d thread%s; errors over %zu common times.", repeats,
@@ -344,8 +345,8 @@ int writeReport(const Plan& plan, const std::string& out, bool json) {
     std::printf(
         "* pareto: no other variant of the scenario is both cheaper (ms per simulated second) and more "
         "accurate (tip RMS error).\n"
-        "model err: one tuft's tip RMS against the reference blade (8 segments, double): 30 s of the scenario's wind "
-        "and a press (docs/grass-models.md).\n");
+        "model err: one tuft's tip RMS against the reference blade (8 segments, double): 30 s of the scenario's wind, "
+        "a press and two balls passing (docs/grass-models.md).\n");
   }
   if (faults > 0) {
     printError("simgrass sweep: %d variant%s faulted (status column in %s)\n", faults, faults == 1 ? "" : "s",

@@ -197,7 +197,7 @@ void takeReference(Plan& plan, size_t s, const Shard& shard, const std::string& 
     for (const json& v : m[key])
       if (!v.is_number_unsigned()) failInput(file, "$.modelError." + key, expected);
     const auto number = [&](size_t k) { return fromBits(m[key][k].get<uint64_t>()); };
-    sc.modelError[key] = {number(0), number(1), number(2), number(3), number(4)};
+    sc.modelError[key] = {number(0), number(1), number(2), number(3), number(4), {NAN, NAN}, {}};
   }
   for (Row& r : plan.rows)
     if (r.scenario == s) r.modelError = sc.modelError.at(r.settings.timeStep->toString());

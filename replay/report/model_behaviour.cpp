@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 #include <stdexcept>
+#include <string>
 
 #include "replay/report/reference_blade.h"
 #include "sim/scenario/derived.h"
@@ -27,7 +28,9 @@ struct PassingBall {
   double radius, height, beside, start, speed;
 };
 constexpr PassingBall kBalls[2] = {{0.5, 1.2, 0.2, -2, 1}, {0.5, 0.6, 0.2, -2, 1}};
-constexpr int64_t kBallMass = 1000;  // kg: it pushes tips by 1000 / (1000 + m_particle) of their depth
+constexpr int64_t kBallMassRatio = 1000;  // the ball's mass over the particle's: it pushes a tip 1000/1001 of its depth
+constexpr int64_t kBallGrid =
+    int64_t(1) << 20;  // L rounded to 2^-20 m (~1 µm) for the ball: exact fractions that stay small
 constexpr double kPressAngle = 70 * 3.14159265358979323846 / 180;
 
 /// The tuft pressed to kPressAngle, at rest.
@@ -165,18 +168,27 @@ int64_t windTicks(double dt) { return std::llround(kErrorWindSeconds / dt); }
 int64_t pressTicks(double dt) { return std::llround(kErrorPressSeconds / dt); }
 int64_t bodyTicks(double dt) { return std::llround(kErrorBodySeconds / dt); }
 
-/// The tuft in still air with a passing ball (runs 3 and 4), untrampled: validated (throws ScenarioError).
+/// The rod length the balls scale with: L rounded to kBallGrid (a long decimal L, 0.1234567890123 m,
+/// made the ball's exact volume overflow), the same in the world and the reference.
+Rational ballScale(const Scenario& tuft) {
+  const double L = tuft.particles.constraintLength.toDouble();
+  if (!(L * double(kBallGrid) >= 1) || !(L < 1e9))
+    throw ScenarioError(tuft.sourceName, "$.particles.constraintLength",
+                        "a rod length from 1 µm to 1e9 m for the model error's passing balls");
+  return Rational::make(std::llround(L * double(kBallGrid)), kBallGrid).value();
+}
+
+/// The tuft in still air with a passing ball (runs 3 and 4), untrampled, without grass drag (the
+/// ball keeps its speed): validated (throws ScenarioError).
 Scenario passingBall(const Scenario& tuft, const PassingBall& b) {
   Scenario s = tuft;
   s.wind.schedule.clear();
   s.particles.blade.trampleSeconds = Rational{0, 1};
   s.bodies.gravity = {Rational{0, 1}, Rational{0, 1}, Rational{0, 1}};
-  const Rational L = s.particles.constraintLength;
-  auto times = [&](double k) {  // k L, exactly (k in tenths)
-    const std::optional<Rational> r = mul(L, Rational{int64_t(std::llround(k * 10)), 10});
-    if (!r)
-      throw ScenarioError(s.sourceName, "$.particles.constraintLength", "a rod length the passing ball can scale with");
-    return *r;
+  s.bodies.grassDrag = Rational{0, 1};
+  const Rational L = ballScale(tuft);
+  auto times = [&](double k) {  // k L, exactly (k in tenths; L a multiple of 2^-20 below 1e9: no overflow)
+    return mul(L, Rational{int64_t(std::llround(k * 10)), 10}).value();
   };
   BodySpec ball;
   ball.name = "passing ball";
@@ -184,7 +196,9 @@ Scenario passingBall(const Scenario& tuft, const PassingBall& b) {
   sphere.type = ShapeType::Sphere;
   sphere.radius = times(b.radius);
   ball.parts = {sphere};
-  ball.mass = Rational::integer(kBallMass);
+  const std::optional<Rational> mass = mul(s.particles.mass, Rational::integer(kBallMassRatio));
+  if (!mass) throw ScenarioError(s.sourceName, "$.particles.mass", "a particle mass the passing ball can scale with");
+  ball.mass = *mass;
   ball.position = {times(b.start), times(b.height), times(b.beside)};  // oneTuft: ground at 0
   ball.velocity = {times(b.speed), Rational{0, 1}, Rational{0, 1}};
   ball.canSleep = false;
@@ -201,6 +215,17 @@ ReferenceBall referenceBall(const PassingBall& p, double L, double dt, int64_t t
   b.from = {L * (p.start + p.speed * dt * double(t - 1)), p.height * L, p.beside * L};
   b.to = {L * (p.start + p.speed * dt * double(t)), p.height * L, p.beside * L};
   return b;
+}
+
+/// The two ball runs' scenarios, or none, with `why` (one line), when they do not validate: the
+/// model error is then the wind and the press alone.
+std::optional<std::array<Scenario, 2>> passingBalls(const Scenario& tuft, std::string* why) {
+  try {
+    return std::array<Scenario, 2>{passingBall(tuft, kBalls[0]), passingBall(tuft, kBalls[1])};
+  } catch (const ScenarioError& e) {
+    *why = e.what();
+    return std::nullopt;
+  }
 }
 
 }  // namespace
@@ -228,8 +253,11 @@ std::vector<std::array<double, 3>> referenceTips(const Scenario& scenario, const
     ref.advance(h, {0, 0, 0});
     tips.push_back(ref.tip());
   }
-  // The bodies passing: the blade upright at rest, a ball moving through it.
-  const double L = tuft.particles.constraintLength.toDouble();
+  // The bodies passing: the blade upright at rest, a ball moving through it (where the ball's
+  // scenario validates: passingBalls).
+  std::string why;
+  if (!passingBalls(tuft, &why)) return tips;
+  const double L = ballScale(tuft).toDouble();
   for (const PassingBall& pass : kBalls) {
     ref.bendTo(0);
     for (int64_t t = 1, ticks = bodyTicks(h); t <= ticks; ++t) {
@@ -247,16 +275,21 @@ ModelError measureModelError(const Scenario& scenario, const Rational& dt,
   const double h = dt.toDouble();
   std::vector<std::array<double, 3>> own;
   if (!reference) reference = &(own = referenceTips(scenario, dt));
-  const int64_t wind = windTicks(h), pressed = wind + pressTicks(h), passTicks = bodyTicks(h);
+  std::string why;
+  const std::optional<std::array<Scenario, 2>> passes = passingBalls(tuft, &why);
+  const int64_t wind = windTicks(h), pressed = wind + pressTicks(h), passTicks = passes ? bodyTicks(h) : 0;
   const int64_t total = pressed + 2 * passTicks;
-  const Scenario passes[2] = {passingBall(tuft, kBalls[0]), passingBall(tuft, kBalls[1])};
   if (int64_t(reference->size()) != total)
     throw std::invalid_argument("measureModelError: the reference tips are not of this scenario and dt");
   ModelError out;
+  if (!passes) {
+    out.bodyRms = out.bodyMax = out.passRms[0] = out.passRms[1] = NAN;
+    out.bodyError = why;
+  }
   double sumSq = 0, bodySumSq = 0, passSumSq[2] = {0, 0};
   int64_t compared = 0;
   const auto failed = [&] {
-    return ModelError{INFINITY, INFINITY, double(compared) * h, INFINITY, INFINITY, {INFINITY, INFINITY}};
+    return ModelError{INFINITY, INFINITY, double(compared) * h, INFINITY, INFINITY, {INFINITY, INFINITY}, why};
   };
   auto compare = [&](const World<double>& w) {
     const auto& p = w.particles();
@@ -290,16 +323,18 @@ ModelError measureModelError(const Scenario& scenario, const Rational& dt,
       compare(w);
     }
   }
-  for (const Scenario& pass : passes) {
-    World<double> w(pass, 1);
+  for (size_t k = 0; passes && k < 2; ++k) {
+    World<double> w((*passes)[k], 1);
     for (int64_t t = 0; t < passTicks; ++t) {
       if (!w.step(TickInput{}).ok) return failed();
       compare(w);
     }
   }
   out.tipRms = compared > 0 ? std::sqrt(sumSq / double(compared)) : 0;
-  out.bodyRms = passTicks > 0 ? std::sqrt(bodySumSq / double(2 * passTicks)) : 0;
-  for (size_t k = 0; k < 2; ++k) out.passRms[k] = passTicks > 0 ? std::sqrt(passSumSq[k] / double(passTicks)) : 0;
+  if (passes && passTicks > 0) {
+    out.bodyRms = std::sqrt(bodySumSq / double(2 * passTicks));
+    for (size_t k = 0; k < 2; ++k) out.passRms[k] = std::sqrt(passSumSq[k] / double(passTicks));
+  }
   out.seconds = double(compared) * h;
   return out;
 }
