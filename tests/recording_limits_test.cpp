@@ -148,14 +148,8 @@ std::string cli() { return quote(SIMGRASS_CLI); }
 
 /// Memory limits (ulimit -v) do not mix with AddressSanitizer's shadow memory.
 bool sanitized() {
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(SIMGRASS_TEST_ASAN)
   return true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-  return true;
-#else
-  return test::slowBuild();
-#endif
 #else
   return test::slowBuild();
 #endif

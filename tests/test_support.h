@@ -2,8 +2,11 @@
 #pragma once
 
 /// SIMGRASS_TEST_ASAN: defined under AddressSanitizer (GCC or Clang), whose shadow memory does
-/// not mix with an address-space limit (ulimit -v): tests that set one skip themselves.
-#if defined(__SANITIZE_ADDRESS__)
+/// not mix with an address-space limit (ulimit -v): tests that set one skip themselves. A
+/// sanitizer build defines it for the test files (tests/CMakeLists.txt), which are compiled
+/// without the sanitizers themselves; the checks below catch a test file built by hand with them.
+#if defined(SIMGRASS_TEST_ASAN)
+#elif defined(__SANITIZE_ADDRESS__)
 #define SIMGRASS_TEST_ASAN 1
 #elif defined(__has_feature)
 #if __has_feature(address_sanitizer)

@@ -317,7 +317,12 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
       const BodySpec& b = s.bodies.list[i];
       const std::string q = "$.bodies.list[" + std::to_string(i) + "]";
       for (int c = 0; c < 3; ++c) {
-        const std::string ix = "[" + std::to_string(c) + "]";
+        // Appended, not "[" + std::to_string(c) + "]": GCC 12 at -O3 reports that expression's
+        // inlined copy as an overlapping memcpy (a false positive, GCC bug 105329) where it sees
+        // more of the code at once (the unity build).
+        std::string ix = "[";
+        ix += std::to_string(c);
+        ix += "]";
         for (const auto& [name, value] : {std::pair{".position", &b.position}, std::pair{".velocity", &b.velocity},
                                           std::pair{".angularVelocity", &b.angularVelocity}}) {
           std::string path = q;

@@ -1,7 +1,8 @@
 // libFuzzer target for the `.sgr` reader: any bytes must give a Recording or an
 // sgr::RecordingError (from parseRecording, snapshotState or recordedScenario), never a crash, an
 // uncaught exception, a hang or a huge allocation. Built by tests/fuzz/CMakeLists.txt (Clang,
-// SIMGRASS_BUILD_FUZZ=ON; the clang-release preset), which also registers the ctest runs.
+// SIMGRASS_BUILD_FUZZ=ON; the clang-asan and clang-release presets), which also registers the
+// ctest runs.
 //
 // Every input is read twice: as it is, and with every complete chunk's checksum (and the HEAD's
 // scenario hash) recomputed. A random mutation almost never keeps an XXH3 checksum right, so
