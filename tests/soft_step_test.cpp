@@ -276,10 +276,14 @@ void expectNoTunnellingIntoHills(const char* name) {
   // Shapes: 0 a ball, 1 a cube, 2 a dumbbell (two balls 3 radii apart: a compound).
   double worst[3] = {1e9, 1e9, 1e9};
   std::string where[3];
+  // The sanitizer build (test::slowBuild) checks a quarter of the drops for memory and UB faults:
+  // the 5 cm bodies at the slowest and the fastest speed (all 384 took 38 s of its run there).
+  const bool all = !test::slowBuild();
   for (const int shape : {0, 1, 2})
     for (const int64_t radiusMm : {50, 100})
       for (const int64_t speed : {10, 100, 300, 500})
         for (int point = 0; point < 16; ++point) {
+          if (!all && (radiusMm != 50 || speed == 100 || speed == 300)) continue;
           Scenario s = emptyWorld();
           s.terrain = hills.terrain;
           Rational3 start, velocity;
