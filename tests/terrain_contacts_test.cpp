@@ -476,10 +476,11 @@ int runRandomScene(uint32_t seed, bool* refused) {
 }
 
 TEST(TerrainContacts, RandomSpikyScenesStep) {
-  // 20 seeds; the sanitizer build (66 s for 20 there) checks the first 5 for memory and UB faults.
+  // 20 seeds; the sanitizer build (66 s for 20 there) checks the first 2 for memory and UB faults
+  // (5 took 24 s of its 30-minute test command; SIMGRASS_RANDOM_SCENES=N runs N by hand).
   const uint32_t seeds = std::getenv("SIMGRASS_RANDOM_SCENES")
                              ? uint32_t(std::atoi(std::getenv("SIMGRASS_RANDOM_SCENES")))
-                             : (test::slowBuild() ? 5 : 20);
+                             : (test::slowBuild() ? 2 : 20);
   int stopped16 = 0, refused16 = 0;
   for (uint32_t seed = 1; seed <= seeds; ++seed) {
     bool refused = false;
