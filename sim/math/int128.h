@@ -1,8 +1,8 @@
 // 128-bit integers for the fixed-point core and the exact rationals: sg::Int128 / sg::UInt128.
 //
-// Where the compiler has __int128 (GCC and Clang on 64-bit targets) and SIMGRASS_PORTABLE_INT128
-// is not defined, they are plain aliases of the builtin types: x86-64 code is exactly what it
-// was (same types, same instructions). Elsewhere (i686, wasm32, or any build defining
+// Where the compiler has __int128 (GCC and Clang on 64-bit targets, Clang on wasm32) and
+// SIMGRASS_PORTABLE_INT128 is not defined, they are plain aliases of the builtin types: x86-64
+// code is exactly what it was (same types, same instructions). Elsewhere (i686, or any build defining
 // SIMGRASS_PORTABLE_INT128) they are sg::portable::Int128 / UInt128: two unsigned 64-bit limbs
 // with the builtin types' semantics, bit for bit, for every operation provided:
 //   * + - * and << wrap modulo 2^128 (two's complement), like the builtin types in GCC/Clang;
