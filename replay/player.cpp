@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "replay/physics_devices.h"
 #include "replay/scenario_files.h"
 
 namespace sg {
@@ -59,7 +60,7 @@ uint64_t largestState(const WorldCounts& c) {
 }  // namespace
 
 Player::Player(const sgr::Recording& recording, int threads, const VariantSettings& variant)
-    : recording_(recording), threads_(variant.threads.value_or(threads)) {
+    : recording_(recording), threads_(variant.threads.value_or(threads)), physics_(variant.physics) {
   scenario_ = recordedScenario(recording, variant);
   // Settings compared once resolved (a recording's variant string may omit keys it left at the
   // scenario's value, e.g. recordings made before `lod` existed).
@@ -69,7 +70,7 @@ Player::Player(const sgr::Recording& recording, int threads, const VariantSettin
   try {
     // The machine's memory is the budget (as for `simgrass record`): a recording whose scenario
     // asks for more is an error here, not a failed allocation later.
-    world_ = makeWorldWithinMemory(scenario_, threads_);
+    buildWorld();
   } catch (const ScenarioError& e) {
     throw sgr::RecordingError(recording.file, sgr::kPreambleBytes,
                               std::string("a scenario this build can run: ") + e.what());
@@ -89,7 +90,14 @@ Player::Player(const sgr::Recording& recording, int threads, const VariantSettin
                               "the physics or the scenario format changed since it was recorded)");
 }
 
-void Player::restart() { world_ = makeWorldWithinMemory(scenario_, threads_); }
+void Player::restart() { buildWorld(); }
+
+void Player::buildWorld() {
+  world_ = makeWorldWithinMemory(scenario_, threads_);
+  if (physics_ && *physics_ != PhysicsPath::Cpu)
+    if (const std::string why = applyPhysicsPath(*world_, *physics_); !why.empty())
+      throw std::invalid_argument(std::string("physics=") + physicsPathName(*physics_) + ": " + why);
+}
 
 StepResult Player::stepForward(StageObserver* observer) {
   return world_->step(recording_.inputAt(world_->tick()), observer);

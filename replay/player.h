@@ -33,6 +33,8 @@ class Player {
  public:
   /// Builds the world. With a non-empty `variant`, the recorded inputs drive a different setup
   /// (then CHCK hashes are not expected to match unless the variant must be bit-identical).
+  /// Throws std::invalid_argument ("physics=gpu: ...") when the variant's physics path cannot run
+  /// this scenario.
   explicit Player(const sgr::Recording& recording, int threads = 1, const VariantSettings& variant = {});
 
   const sgr::Recording& recording() const { return recording_; }
@@ -58,9 +60,11 @@ class Player {
 
  private:
   void restart();
+  void buildWorld();
   const sgr::Recording& recording_;
   Scenario scenario_;
   int threads_;
+  std::optional<PhysicsPath> physics_;  ///< the variant's, put on every world this player builds
   bool sameSettings_ = true;
   bool exactSettings_ = true;  ///< every setting as recorded (threads aside): snapshots compare byte for byte
   uint64_t largestStateBytes_ = 0;

@@ -25,7 +25,7 @@ VariantSettings VariantSettings::parse(const std::string& text) {
   while (in >> item) {
     const size_t eq = item.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
-      bad(item, "key=value with a key scalar, interp, broadphase, body-broadphase, dt, lod, model or threads");
+      bad(item, "key=value with a key scalar, interp, broadphase, body-broadphase, dt, lod, model, threads or physics");
     const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
     // "scalar=fx16,scalar=double" silently took the last: a variant names each setting once.
     if (!seen.insert(key).second) bad(item, "each key once (" + key + " is given twice)");
@@ -81,8 +81,17 @@ VariantSettings VariantSettings::parse(const std::string& text) {
         v.model = GrassModel::Blade;
       else
         bad(item, "model=thesis, pbd or blade");
+    } else if (key == "physics") {
+      if (value == "cpu")
+        v.physics = PhysicsPath::Cpu;
+      else if (value == "gpu")
+        v.physics = PhysicsPath::Gpu;
+      else if (value == "gpu-readback")
+        v.physics = PhysicsPath::GpuReadback;
+      else
+        bad(item, "physics=cpu, gpu or gpu-readback");
     } else {
-      bad(item, "a key scalar, interp, broadphase, body-broadphase, dt, lod, model or threads");
+      bad(item, "a key scalar, interp, broadphase, body-broadphase, dt, lod, model, threads or physics");
     }
   }
   return v;
@@ -98,6 +107,7 @@ VariantSettings VariantSettings::over(const VariantSettings& base) const {
   if (threads) v.threads = threads;
   if (lod) v.lod = lod;
   if (model) v.model = model;
+  if (physics) v.physics = physics;
   return v;
 }
 
@@ -148,6 +158,7 @@ std::string VariantSettings::describe() const {
   if (lod) add(std::string("lod=") + (*lod == LodMode::Window ? "window" : "off"));
   if (model) add(std::string("model=") + grassModelName(*model));
   if (threads) add("threads=" + std::to_string(*threads));
+  if (physics) add(std::string("physics=") + physicsPathName(*physics));
   return out;
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sim/math/rational.h"
+#include "sim/particles/particle_kernel.h"
 #include "sim/scenario/scenario.h"
 
 namespace sg {
@@ -24,6 +25,9 @@ struct VariantSettings {
   /// particles' acceleration, initial velocity and damping (the thesis' 1 m/s^2 lift is not a blade's
   /// gravity); everything else stays.
   std::optional<GrassModel> model;
+  /// Where the grass stages run (cpu, gpu, gpu-readback): not part of the state, so it must be
+  /// bit-identical, like threads (docs/gpu-physics.md).
+  std::optional<PhysicsPath> physics;
 
   /// Parses "interp=2", "scalar=fx16,dt=1/120", ...; later keys override earlier ones.
   /// Throws std::invalid_argument with "key=value: expected ..." on a bad setting.

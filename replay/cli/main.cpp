@@ -12,6 +12,7 @@
 
 #include "replay/cli/compare_command.h"
 #include "replay/cli/diff_command.h"
+#include "replay/cli/gpu_hook.h"
 #include "replay/cli/record_command.h"
 #include "replay/cli/render_hook.h"
 #include "replay/cli/replay_command.h"
@@ -64,6 +65,7 @@ int main(int argc, char** argv) {
     sg::printError("simgrass: SIMGRASS_KERNEL: expected scalar, avx2 or auto");
     return 2;
   }
+  sg::registerBuildGpuPhysics();  // `--physics gpu`: sim/gpu's devices, or none in a build without GL
   int exitCode = 0;
   sg::addRunCommand(app, &exitCode);
   sg::addRecordCommand(app, &exitCode);

@@ -10,6 +10,7 @@
 
 #include "replay/cli/cli_common.h"
 #include "replay/input_file.h"
+#include "replay/physics_devices.h"
 #include "replay/progress.h"
 #include "replay/recorder.h"
 #include "replay/scenario_files.h"
@@ -54,6 +55,7 @@ std::string sharedKeys(const VariantSettings& a, const VariantSettings& b) {
   both(a.timeStep.has_value(), b.timeStep.has_value(), "dt");
   both(a.lod.has_value(), b.lod.has_value(), "lod");
   both(a.model.has_value(), b.model.has_value(), "model");
+  both(a.physics.has_value(), b.physics.has_value(), "physics");
   return keys;
 }
 
@@ -90,6 +92,9 @@ int record(const RecordOptions& o) {
       track = parseInputTrack(text, o.inputTrack, scenario);
     }
     world = makeWorldWithinMemory(scenario, o.threads);
+    if (variant.physics)
+      if (const std::string why = applyPhysicsPath(*world, *variant.physics); !why.empty())
+        throw std::invalid_argument(std::string("physics=") + physicsPathName(*variant.physics) + ": " + why);
   } catch (const std::invalid_argument& e) {
     printError("simgrass record: --variant %s\n", e.what());
     return kExitBadInput;
@@ -200,11 +205,11 @@ void addRecordCommand(CLI::App& app, int* exitCode) {
                   "Input-track JSON (camera keys and body commands) instead of the scenario's script");
   cmd->add_option("--variant", o->variants,
                   "Settings over the scenario: scalar=fx16, interp=2, broadphase=brute, "
-                  "body-broadphase=sap, dt=1/120, lod=off, model=blade (repeatable)")
+                  "body-broadphase=sap, dt=1/120, lod=off, model=blade, physics=gpu (repeatable)")
       ->allow_extra_args(false);  // one value per --variant: a scenario path after it stays the scenario
   // The same flags as `simgrass run`, each a shorthand for --variant KEY=VALUE.
   o->shorthands = {{"scalar", ""}, {"interp", ""}, {"broadphase", ""}, {"body-broadphase", ""},
-                   {"lod", ""},    {"dt", ""},     {"model", ""}};
+                   {"lod", ""},    {"dt", ""},     {"model", ""},      {"physics", ""}};
   // A flag's value is one word: empty or spaced values would be read as no flag, or split.
   const CLI::Validator oneWord(
       [](std::string& v) {
@@ -231,6 +236,11 @@ void addRecordCommand(CLI::App& app, int* exitCode) {
   cmd->add_option("--dt", o->shorthands[5].second, "Time step in s, e.g. 1/120 (= --variant dt=...)")->check(oneWord);
   cmd->add_option("--model", o->shorthands[6].second, "Grass model: thesis, pbd or blade (= --variant model=...)")
       ->check(CLI::IsMember({"thesis", "pbd", "blade"}))
+      ->check(oneWord);
+  cmd->add_option("--physics", o->shorthands[7].second,
+                  "Where the grass stages run: cpu, gpu or gpu-readback (= --variant physics=...; the recording is "
+                  "identical on every path, docs/gpu-physics.md)")
+      ->check(CLI::IsMember({"cpu", "gpu", "gpu-readback"}))
       ->check(oneWord);
   cmd->add_option("--threads", o->threads, "Worker threads (the recording is identical for any count)")
       ->check(CLI::Range(1, 256));

@@ -9,6 +9,7 @@
 #include "replay/cli/cli_common.h"
 #include "replay/cli/divergence_report.h"
 #include "replay/output_file.h"
+#include "replay/physics_devices.h"
 #include "replay/player.h"
 #include "replay/progress.h"
 #include "replay/state_export.h"
@@ -20,6 +21,7 @@ struct ReplayOptions {
   bool verify = false, info = false, json = false;
   int64_t to = -1;
   int threads = 1;
+  std::string physics = "cpu";
 };
 
 /// The hash the recording holds for `tick`, if any.
@@ -81,10 +83,15 @@ int replay(const ReplayOptions& o) {
     return rec->truncated ? kExitTruncated : kExitOk;
   }
   std::unique_ptr<Player> player;
+  VariantSettings onPath;  // --physics: the same bits, so every recorded hash still applies
+  onPath.physics = parsePhysicsPath(o.physics);
   try {
-    player = std::make_unique<Player>(*rec, o.threads);
+    player = std::make_unique<Player>(*rec, o.threads, onPath);
   } catch (const sgr::RecordingError& e) {
     printError("simgrass replay: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const std::invalid_argument& e) {
+    printError("simgrass replay: %s: --%s\n", o.file.c_str(), e.what());
     return kExitBadInput;
   }
   const int64_t last = rec->lastTick();
@@ -134,7 +141,7 @@ int replay(const ReplayOptions& o) {
     }
     if (code == kExitOk && (o.to >= 0 || !o.verify)) {
       if (inFaultedStep) {  // seek from a fresh world, not from inside the faulted step
-        player = std::make_unique<Player>(*rec, o.threads);
+        player = std::make_unique<Player>(*rec, o.threads, onPath);
         inFaultedStep = false;
       }
       const int64_t target = o.to >= 0 ? o.to : last;
@@ -217,6 +224,10 @@ void addReplayCommand(CLI::App& app, int* exitCode) {
                   "state (docs/state-format.md)");
   cmd->add_option("--threads", o->threads, "Worker threads (the result is identical for any count)")
       ->check(CLI::Range(1, 256));
+  cmd->add_option("--physics", o->physics,
+                  "Where the grass stages run: cpu, gpu or gpu-readback (the state is identical, so the recorded "
+                  "hashes verify on any path; docs/gpu-physics.md)")
+      ->check(CLI::IsMember({"cpu", "gpu", "gpu-readback"}));
   cmd->add_flag("--info", o->info, "Print what the recording holds without simulating");
   cmd->add_flag("--json", o->json, "Machine-readable output");
   cmd->footer(

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "replay/cli/cli_common.h"
+#include "replay/physics_devices.h"
 #include "replay/progress.h"
 #include "replay/scenario_files.h"
 #include "replay/stage_clock.h"
@@ -22,10 +23,11 @@ struct RunOptions {
   int interp = 0;
   int threads = 1;
   int64_t hashEvery = 0;
-  std::string broadphase;      // particles vs bodies: grid | brute
-  std::string bodyBroadphase;  // bodies vs bodies: brute | sap
-  std::string lod;             // off | window
-  std::string kernel;          // particle pass: auto | scalar | avx2
+  std::string broadphase;       // particles vs bodies: grid | brute
+  std::string bodyBroadphase;   // bodies vs bodies: brute | sap
+  std::string lod;              // off | window
+  std::string kernel;           // particle pass: auto | scalar | avx2
+  std::string physics = "cpu";  // where the grass stages run: cpu | gpu | gpu-readback
   bool json = false;
 };
 
@@ -52,6 +54,11 @@ int runScenario(const RunOptions& o) {
     world = makeWorld(scenario, o.threads, physicalMemoryBytes());
     if (o.kernel == "scalar" || o.kernel == "avx2")
       world->setParticleKernel(o.kernel == "avx2" ? ParticleKernel::Avx2 : ParticleKernel::Scalar);
+    if (const std::string why = applyPhysicsPath(*world, *parsePhysicsPath(o.physics)); !why.empty()) {
+      printError("simgrass run: %s: --physics %s: %s\n", o.scenario.empty() ? "<built-in>" : o.scenario.c_str(),
+                 o.physics.c_str(), why.c_str());
+      return 2;
+    }
   } catch (const ScenarioError& e) {
     printError("simgrass run: %s\n", e.what());
     return 2;
@@ -110,6 +117,7 @@ int runScenario(const RunOptions& o) {
     j["model"] = grassModelName(scenario.particles.model);
     j["kernel"] = particleKernel;
     j["patchKernel"] = patchKernel;
+    j["physics"] = describePhysics(*world);
     j["counts"] = {{"patchesX", counts.patchesX},     {"patchesZ", counts.patchesZ},
                    {"patches", counts.patches()},     {"particlesX", counts.particlesX},
                    {"particlesZ", counts.particlesZ}, {"particles", counts.particles()},
@@ -139,6 +147,7 @@ int runScenario(const RunOptions& o) {
                                    patchKernel + " patch kernel";
     std::printf("scalar     %s, interpolation k=%d, %d thread%s, %s\n", scalarName(scenario.scalar),
                 counts.interpolation, counts.threads, counts.threads == 1 ? "" : "s", kernelText.c_str());
+    if (world->physicsPath() != PhysicsPath::Cpu) std::printf("physics    %s\n", describePhysics(*world).c_str());
     std::printf(
         "patches    %" PRId64 " (%" PRId64 " x %" PRId64 "), particles %" PRId64 " (%" PRId64 " x %" PRId64 ")\n",
         counts.patches(), counts.patchesX, counts.patchesZ, counts.particles(), counts.particlesX, counts.particlesZ);
@@ -196,6 +205,11 @@ void addRunCommand(CLI::App& app, int* exitCode) {
                   "Particle pass and patch stage: auto (AVX2 where the CPU has it), scalar (the reference) or avx2 "
                   "(the state is identical; --json's kernel and patchKernel say what ran)")
       ->check(CLI::IsMember({"auto", "scalar", "avx2"}));
+  run->add_option("--physics", opts->physics,
+                  "Where the grass stages run: cpu, gpu (compute shaders; the particles are read back only to "
+                  "hash, save or draw) or gpu-readback (the thesis' design: read back every tick). The state is "
+                  "identical (docs/gpu-physics.md)")
+      ->check(CLI::IsMember({"cpu", "gpu", "gpu-readback"}));
   run->add_flag("--json", opts->json, "Machine-readable output");
   run->callback([opts, exitCode] { *exitCode = runScenario(*opts); });
 }

@@ -26,4 +26,13 @@ ParticleKernel defaultParticleKernel();
 /// Scalar.
 void setDefaultParticleKernel(ParticleKernel kernel);
 
+/// Where the grass stages run (`--physics`; docs/gpu-physics.md). Every path gives the CPU's bits.
+enum class PhysicsPath : uint8_t {
+  Cpu = 0,          ///< the CPU kernels above
+  Gpu = 1,          ///< a device holds the particles; copied back only when hashed, saved or read
+  GpuReadback = 2,  ///< the thesis' design: the device steps, the state is copied back every tick
+};
+/// "cpu", "gpu" or "gpu-readback".
+const char* physicsPathName(PhysicsPath path);
+
 }  // namespace sg

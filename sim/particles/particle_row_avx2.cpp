@@ -21,6 +21,9 @@
 namespace sg {
 
 const char* particleKernelName(ParticleKernel kernel) { return kernel == ParticleKernel::Avx2 ? "avx2" : "scalar"; }
+const char* physicsPathName(PhysicsPath path) {
+  return path == PhysicsPath::Gpu ? "gpu" : path == PhysicsPath::GpuReadback ? "gpu-readback" : "cpu";
+}
 
 #if defined(__x86_64__)
 

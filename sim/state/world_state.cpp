@@ -38,6 +38,7 @@ void checkFloatValues(state::Cursor at, uint64_t n, const char* what) {
 template <class S>
 void World<S>::serialise(StateSink& sink) const {
   using namespace state;
+  syncFromDevice();
   const uint64_t n = uint64_t(grid_.size());
   sink.write(kMagic, sizeof kMagic);
 
@@ -283,6 +284,8 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
 
   // Everything checked: apply. Static window data first (anchors, patches, cut flags from the
   // restored cuts), then the particles' dynamic state over it.
+  deviceAhead_ = false;  // the restored state replaces a device's: uploaded before the next pass
+  hostAhead_ = true;
   cuts_ = std::move(cuts);
   if (lodWindow_) fillWindow(originI, originJ, false);
   for (auto* v : {&particles_.px, &particles_.py, &particles_.pz, &particles_.vx, &particles_.vy, &particles_.vz})
@@ -319,6 +322,7 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
 template <class S>
 void World<S>::exportState(StateExport& out) const {
   using T = ScalarTraits<S>;
+  syncFromDevice();
   out = StateExport{};
   out.scalar = T::kind;
   out.tick = tick_;

@@ -18,6 +18,8 @@
 
 namespace sg {
 
+class ParticleDeviceProvider;  // sim/particles/particle_device.h
+
 /// A simulation fault: arithmetic that did not fit the scalar, reported with where it happened.
 struct SimError {
   int64_t tick = -1;
@@ -117,6 +119,12 @@ class SimWorld {
   /// scalar reference.
   virtual void setParticleKernel(ParticleKernel kernel) = 0;
   virtual ParticleKernel particleKernel() const = 0;
+  /// Moves the grass stages onto a device from `provider` (PhysicsPath::Gpu, GpuReadback) or back
+  /// to the CPU (Cpu; provider unused). Returns "" on success, else one line saying why this world
+  /// cannot (the world is then unchanged). Every path gives the same state bits and fault reports
+  /// (docs/gpu-physics.md).
+  virtual std::string setPhysicsPath(PhysicsPath path, ParticleDeviceProvider* provider) = 0;
+  virtual PhysicsPath physicsPath() const = 0;
   /// The whole state as plain numbers (StateExport).
   virtual void exportState(StateExport& out) const = 0;
   /// Fills `out` (reusing its storage) with the current tips and body poses.

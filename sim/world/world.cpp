@@ -232,6 +232,7 @@ WorldCounts World<S>::counts() const {
 
 template <class S>
 void World<S>::observe(Observation& out) const {
+  syncFromDevice();
   out.tick = tick_;
   out.patchesX = lattice_.patchesX;
   out.patchesZ = lattice_.patchesZ;

@@ -23,6 +23,7 @@
 #include "sim/field/grass_field.h"
 #include "sim/field/markings.h"
 #include "sim/lod/edge_ring.h"
+#include "sim/particles/particle_device.h"
 #include "sim/particles/particle_row.h"
 #include "sim/particles/particles.h"
 #include "sim/patches/patch_state.h"
@@ -54,15 +55,27 @@ class World final : public SimWorld {
     particleKernel_ = vector ? ParticleKernel::Avx2 : ParticleKernel::Scalar;
   }
   ParticleKernel particleKernel() const override { return particleKernel_; }
+  std::string setPhysicsPath(PhysicsPath path, ParticleDeviceProvider* provider) override;
+  PhysicsPath physicsPath() const override { return physicsPath_; }
   void exportState(StateExport& out) const override;
   void observe(Observation& out) const override;
   int32_t bodyTemplate(int64_t body) const override;
   bool bladeOn(int64_t body) const override;
 
-  // Read access for tests, tools and the renderer.
-  const ParticleArrays<S>& particles() const { return particles_; }
-  ParticleArrays<S>& mutableParticles() { return particles_; }  ///< tests: set up states
-  const PatchArrays<S>& patches() const { return patches_; }
+  // Read access for tests, tools and the renderer (each copies a device's particles back first).
+  const ParticleArrays<S>& particles() const {
+    syncFromDevice();
+    return particles_;
+  }
+  ParticleArrays<S>& mutableParticles() {  ///< tests: set up states
+    syncFromDevice();
+    hostAhead_ = true;
+    return particles_;
+  }
+  const PatchArrays<S>& patches() const {
+    syncFromDevice();
+    return patches_;
+  }
   /// Which patches patches() holds; storageIndex(i, j) finds patch (i, j) (row-major j * patchesX
   /// + i with the level of detail off).
   const LatticeWindow& patchWindow() const { return patchWindow_; }
@@ -90,6 +103,15 @@ class World final : public SimWorld {
   bool collisionStage();
   bool integrateStage();
   bool patchStage();
+  /// The integrate stage's particle pass on the device (physics path Gpu or GpuReadback); false
+  /// when it faulted, with the tick's input back on the host for the CPU reference to redo.
+  bool deviceParticlePass();
+  /// Why this world's grass stages cannot run on a device ("" when they can).
+  std::string deviceLimitation() const;
+  /// Copies the device's particles back when they are newer than the host's, and derives the
+  /// patches from them (the patch stage the device path left to this point). Const: it changes
+  /// no state, only where the state is held.
+  void syncFromDevice() const;
   /// Records a fixed-point fault of `stage` as the world's failure; returns false.
   bool failWith(Stage stage, uint32_t faults);
   template <class Fn>
@@ -174,6 +196,13 @@ class World final : public SimWorld {
   bool failed_ = false;
   SimError failure_;
   std::unique_ptr<ChunkPool> pool_;
+  // The device path (docs/gpu-physics.md). The particles live in one place at a time: the host
+  // arrays above, or the device after a pass (deviceAhead_); hostAhead_ says the host arrays
+  // changed since the last upload (a restore, a test's edits).
+  PhysicsPath physicsPath_ = PhysicsPath::Cpu;
+  std::unique_ptr<ParticleDevice<S>> device_;
+  bool deviceAhead_ = false;
+  bool hostAhead_ = false;
 };
 
 }  // namespace sg

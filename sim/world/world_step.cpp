@@ -11,6 +11,7 @@ namespace sg {
 
 template <class S>
 void World<S>::updatePatchState() {
+  syncFromDevice();
   const S rod = particleConsts_.rodLength;
   pool_->run((grid_.countZ + rowsPerChunk_ - 1) / rowsPerChunk_, [&](int64_t c, int) {
     const int64_t b1 = std::min(grid_.countZ, (c + 1) * rowsPerChunk_);
@@ -137,6 +138,9 @@ bool World<S>::integrateStage() {
     return pbd ? advanceParticleRow<S, true>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_)
                : advanceParticleRow<S, false>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_);
   };
+  // On a device (world_device.cpp; no bodies on that path), unless the pass faulted: then the
+  // reference below redoes the tick and reports the fault.
+  if (device_ && deviceParticlePass()) return true;
   const bool rowUniform = windSchedule_.rowUniform();
   const LatticeWindow& window = grid_.window;
   const bool moved = runParticleRows(Stage::Integrate, [&](int64_t row, int64_t b, int64_t e) -> RowFault {
@@ -181,7 +185,9 @@ template <class S>
 bool World<S>::patchStage() {
   // The patch stage is derived data only (never fed back into the state) and runs unchecked
   // arithmetic with Fixed's exact bits (patches/patch_state.h); like the window, its bits are
-  // cleared so they cannot be blamed on a later stage.
+  // cleared so they cannot be blamed on a later stage. With the particles on a device, the
+  // patches are derived when the host next reads them (syncFromDevice).
+  if (deviceAhead_) return true;
   updatePatchesFromDisplacement();
   takeFixedFaults();
   return true;

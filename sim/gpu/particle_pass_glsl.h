@@ -1,0 +1,246 @@
+// The fused particle pass (sim/particles/particle_row.h) as an OpenGL 4.3 compute shader, one
+// invocation per particle, in the fixed-point formats' exact integer arithmetic
+// (GL_ARB_gpu_shader_int64). Each operation gives sim/math/fixed.h's bits and raises the same
+// overflow: sums wrap and are checked by sign; products round to nearest, ties away from zero,
+// Q32.32's 128-bit product built from 32 x 32 -> 64 partial products; L / |d| and |d| are guessed
+// in double precision and then settled in exact integer arithmetic (the guess only decides how
+// many correction steps run, never the result). The prelude gl_physics.cpp puts before this text
+// defines FX32 or FX16 and PBD (0 or 1).
+#pragma once
+
+namespace sg::gpu {
+
+inline constexpr const char* kParticlePassGlsl = R"GLSL(
+layout(local_size_x = 256) in;
+
+#if FX32
+#define RAW int64_t
+#define FRAC 32
+#else
+#define RAW int
+#define FRAC 16
+#endif
+
+// Each buffer holds three arrays of `count` values (x, then y, then z). The pass reads one set of
+// positions and velocities and writes the other: a pass that faults leaves the tick's input
+// intact, so the CPU reference can redo that tick (docs/gpu-physics.md, "Faults").
+layout(std430, binding = 0) readonly buffer PositionIn { RAW positionIn[]; };
+layout(std430, binding = 1) readonly buffer VelocityIn { RAW velocityIn[]; };
+layout(std430, binding = 2) writeonly buffer PositionOut { RAW positionOut[]; };
+layout(std430, binding = 3) writeonly buffer VelocityOut { RAW velocityOut[]; };
+layout(std430, binding = 4) readonly buffer Anchor { RAW anchor[]; };
+layout(std430, binding = 5) writeonly buffer Displacement { RAW displacement[]; };
+// [0..3]: dt, damping per tick, rod length, 1/dt; then (a + F/m) dt of row r at 4 + 3r (x, y, z).
+layout(std430, binding = 6) readonly buffer Tick { RAW tickData[]; };
+// The smallest fault key: row * 2 countX + (projection ? countX : 0) + column (0xffffffff: none).
+layout(std430, binding = 7) buffer Fault { uint faultKey; };
+
+uniform uint countX;
+uniform uint count;
+
+bool overflowed;  // this invocation's fault bit (Fixed's kFixedFaultOverflow)
+
+const double kTwo64 = 18446744073709551616.0;
+const uint64_t kAllOnes = 0xFFFFFFFFFFFFFFFFul;
+
+// ---- unsigned 128-bit helpers (hi, lo) ------------------------------------------------------
+// a * b exactly, from four 32 x 32 -> 64 partial products.
+void mul64x64(uint64_t a, uint64_t b, out uint64_t hi, out uint64_t lo) {
+  uint64_t al = a & 0xFFFFFFFFul, ah = a >> 32, bl = b & 0xFFFFFFFFul, bh = b >> 32;
+  uint64_t p0 = al * bl, p1 = al * bh, p2 = ah * bl, p3 = ah * bh;
+  uint64_t mid = (p0 >> 32) + (p1 & 0xFFFFFFFFul) + (p2 & 0xFFFFFFFFul);  // < 3 * 2^32
+  lo = (mid << 32) | (p0 & 0xFFFFFFFFul);
+  hi = p3 + (p1 >> 32) + (p2 >> 32) + (mid >> 32);
+}
+bool lessOrEqual128(uint64_t ah, uint64_t al, uint64_t bh, uint64_t bl) { return ah < bh || (ah == bh && al <= bl); }
+// |a - b| and whether a >= b.
+bool difference128(uint64_t ah, uint64_t al, uint64_t bh, uint64_t bl, out uint64_t dh, out uint64_t dl) {
+  bool aAbove = lessOrEqual128(bh, bl, ah, al);
+  if (aAbove) { dl = al - bl; dh = ah - bh - (al < bl ? 1ul : 0ul); }
+  else { dl = bl - al; dh = bh - ah - (bl < al ? 1ul : 0ul); }
+  return aAbove;
+}
+double toDouble128(uint64_t hi, uint64_t lo) { return double(hi) * kTwo64 + double(lo); }
+uint64_t clampedGuess(double g) { return g >= 18446744073709549568.0 ? kAllOnes : (g > 0.0 ? uint64_t(g) : 0ul); }
+
+// floor(n / d) and the remainder, for nh < d (the quotient fits 64 bits): a double guess, then
+// Newton-like corrections from the exact remainder (one or two in practice), with schoolbook
+// long division as the bounded fallback.
+void divide128by64(uint64_t nh, uint64_t nl, uint64_t d, out uint64_t q, out uint64_t r) {
+  double dd = double(d);
+  uint64_t guess = clampedGuess(toDouble128(nh, nl) / dd);
+  for (int step = 0; step < 8; ++step) {
+    uint64_t ph, pl, eh, el;
+    mul64x64(guess, d, ph, pl);
+    bool below = difference128(nh, nl, ph, pl, eh, el);  // guess d <= n
+    if (below && eh == 0ul && el < d) { q = guess; r = el; return; }
+    uint64_t move = max(uint64_t(toDouble128(eh, el) / dd), 1ul);
+    guess = below ? guess + move : guess - move;
+  }
+  uint64_t rem = 0ul, quo = 0ul;  // never reached in tests; exact for any nh < d
+  for (int bit = 127; bit >= 0; --bit) {
+    uint64_t top = rem >> 63;
+    rem = (rem << 1) | ((bit >= 64 ? (nh >> (bit - 64)) : (nl >> bit)) & 1ul);
+    if (top != 0ul || rem >= d) { rem -= d; if (bit < 64) quo |= 1ul << bit; }
+  }
+  q = quo;
+  r = rem;
+}
+
+// floor(sqrt(n)) for any 128-bit n: a double guess, then corrections from the exact n - r^2.
+uint64_t isqrtFloor128(uint64_t nh, uint64_t nl) {
+  uint64_t r = clampedGuess(sqrt(toDouble128(nh, nl)));
+  for (int step = 0; step < 64; ++step) {
+    uint64_t sh, sl, eh, el;
+    mul64x64(r, r, sh, sl);
+    bool below = difference128(nh, nl, sh, sl, eh, el);  // r^2 <= n
+    // floor: r^2 <= n < (r + 1)^2, i.e. n - r^2 <= 2r
+    if (below && lessOrEqual128(eh, el, r >> 63, r << 1)) return r;
+    double slope = 2.0 * double(r) + 1.0;
+    uint64_t move = max(uint64_t(toDouble128(eh, el) / slope), 1ul);
+    r = below ? r + move : r - move;
+  }
+  return r;  // unreachable: each step at least halves the error once the guess is close
+}
+
+#if FX32
+// ---- Q32.32 (fixed.h's Fx32: int64 raw, 128-bit wide) ---------------------------------------
+RAW addChecked(RAW a, RAW b) { RAW r = a + b; if (((a ^ r) & (b ^ r)) < 0l) overflowed = true; return r; }
+RAW subChecked(RAW a, RAW b) { RAW r = a - b; if (((a ^ b) & (a ^ r)) < 0l) overflowed = true; return r; }
+uint64_t magnitude(RAW a) { return a < 0l ? uint64_t(-a) : uint64_t(a); }  // INT64_MIN: 2^63
+// Fixed::operator*: round(a b / 2^32), ties away from zero (the rounding is symmetric, so it is
+// formed on magnitudes), then narrowed to 64 bits (wrapping, with the overflow raised).
+RAW mulChecked(RAW a, RAW b) {
+  bool negative = (a < 0l) != (b < 0l);
+  uint64_t hi, lo;
+  mul64x64(magnitude(a), magnitude(b), hi, lo);
+  uint64_t rounded = lo + 0x80000000ul;
+  hi += rounded < lo ? 1ul : 0ul;
+  uint64_t m = (hi << 32) | (rounded >> 32);
+  if ((hi >> 32) != 0ul || m > (negative ? 0x8000000000000000ul : 0x7FFFFFFFFFFFFFFFul)) overflowed = true;
+  return negative ? -RAW(m) : RAW(m);
+}
+// Fixed::operator/ for b != 0: round(a 2^32 / b), ties away from zero.
+RAW divChecked(RAW a, RAW b) {
+  bool negative = (a < 0l) != (b < 0l);
+  uint64_t ua = magnitude(a), ud = magnitude(b);
+  uint64_t nh = ua >> 32, nl = ua << 32;
+  if (nh >= ud) { overflowed = true; return negative ? RAW(0x8000000000000000ul) : RAW(0x7FFFFFFFFFFFFFFFul); }
+  uint64_t q, r;
+  divide128by64(nh, nl, ud, q, r);
+  bool up = r >= ud - r;
+  if (up && q == kAllOnes) { overflowed = true; return negative ? RAW(0x8000000000000000ul) : RAW(0x7FFFFFFFFFFFFFFFul); }
+  uint64_t m = q + (up ? 1ul : 0ul);
+  if (m > (negative ? 0x8000000000000000ul : 0x7FFFFFFFFFFFFFFFul)) overflowed = true;
+  return negative ? -RAW(m) : RAW(m);
+}
+// length3: isqrtNearest of the exact 128-bit sum of squares (< 3 2^126: no carry out).
+RAW length3(RAW x, RAW y, RAW z) {
+  uint64_t h = 0ul, l = 0ul;
+  RAW v[3] = RAW[3](x, y, z);
+  for (int a = 0; a < 3; ++a) {
+    uint64_t sh, sl;
+    uint64_t m = magnitude(v[a]);
+    mul64x64(m, m, sh, sl);
+    l += sl;
+    h += sh + (l < sl ? 1ul : 0ul);
+  }
+  uint64_t r = isqrtFloor128(h, l);
+  uint64_t sh, sl, eh, el;
+  mul64x64(r, r, sh, sl);
+  difference128(h, l, sh, sl, eh, el);  // n - r^2 >= 0
+  if (eh != 0ul || el > r) r += 1ul;    // isqrtNearest
+  if (r > 0x7FFFFFFFFFFFFFFFul) overflowed = true;
+  return RAW(r);
+}
+#else
+// ---- Q16.16 (fixed.h's Fx16: int32 raw, 64-bit wide) ----------------------------------------
+RAW addChecked(RAW a, RAW b) { RAW r = a + b; if (((a ^ r) & (b ^ r)) < 0) overflowed = true; return r; }
+RAW subChecked(RAW a, RAW b) { RAW r = a - b; if (((a ^ b) & (a ^ r)) < 0) overflowed = true; return r; }
+RAW narrow(int64_t w) {
+  if (w > 2147483647l || w < -2147483648l) overflowed = true;
+  return RAW(uint(uint64_t(w) & 0xFFFFFFFFul));  // the low 32 bits, as static_cast does
+}
+RAW mulChecked(RAW a, RAW b) {
+  int64_t p = int64_t(a) * int64_t(b);
+  return narrow((p + (1l << 15) + (p >> 63)) >> 16);
+}
+RAW divChecked(RAW a, RAW b) {
+  bool negative = (a < 0) != (b < 0);
+  uint64_t un = uint64_t(abs(int64_t(a))) << 16, ud = uint64_t(abs(int64_t(b)));
+  uint64_t q = un / ud, r = un - q * ud;
+  uint64_t m = q + (r >= ud - r ? 1ul : 0ul);
+  return narrow(negative ? -int64_t(m) : int64_t(m));
+}
+RAW length3(RAW x, RAW y, RAW z) {
+  uint64_t mx = uint64_t(abs(int64_t(x))), my = uint64_t(abs(int64_t(y))), mz = uint64_t(abs(int64_t(z)));
+  uint64_t n = mx * mx + my * my + mz * mz;  // < 3 2^62
+  uint64_t r = isqrtFloor128(0ul, n);
+  if (n - r * r > r) r += 1ul;
+  if (r > 2147483647ul) overflowed = true;
+  return RAW(uint(r));
+}
+#endif
+
+void noteFault(uint key) { atomicMin(faultKey, key); }
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= count) return;
+  uint row = i / countX, column = i - row * countX;
+  RAW dt = tickData[0], damping = tickData[1], rod = tickData[2], invDt = tickData[3];
+  RAW dvx = tickData[4 + 3 * row], dvy = tickData[5 + 3 * row], dvz = tickData[6 + 3 * row];
+  uint j = i + count, k = j + count;  // y and z of particle i
+  RAW x = positionIn[i], y = positionIn[j], z = positionIn[k];
+  RAW u = velocityIn[i], v = velocityIn[j], w = velocityIn[k];
+
+  // Stage 3, integrate.h: explicit order for "thesis", symplectic for "pbd".
+  overflowed = false;
+#if !PBD
+  x = addChecked(x, mulChecked(u, dt));
+  y = addChecked(y, mulChecked(v, dt));
+  z = addChecked(z, mulChecked(w, dt));
+#endif
+  u = mulChecked(addChecked(u, dvx), damping);
+  v = mulChecked(addChecked(v, dvy), damping);
+  w = mulChecked(addChecked(w, dvz), damping);
+#if PBD
+  x = addChecked(x, mulChecked(u, dt));
+  y = addChecked(y, mulChecked(v, dt));
+  z = addChecked(z, mulChecked(w, dt));
+#endif
+  if (overflowed) noteFault(row * 2u * countX + column);
+
+  // Stage 4, rod_constraint.h.
+  overflowed = false;
+  RAW ax = anchor[i], ay = anchor[j], az = anchor[k];
+  RAW dx = subChecked(x, ax), dy = subChecked(y, ay), dz = subChecked(z, az);
+  RAW len = length3(dx, dy, dz);
+  RAW nx, ny, nz;
+  if (len == RAW(0)) {
+    nx = ax;
+    ny = addChecked(ay, rod);
+    nz = az;
+  } else {
+    RAW scale = divChecked(rod, len);
+    nx = addChecked(ax, mulChecked(dx, scale));
+    ny = addChecked(ay, mulChecked(dy, scale));
+    nz = addChecked(az, mulChecked(dz, scale));
+  }
+#if PBD
+  u = addChecked(u, mulChecked(subChecked(nx, x), invDt));
+  v = addChecked(v, mulChecked(subChecked(ny, y), invDt));
+  w = addChecked(w, mulChecked(subChecked(nz, z), invDt));
+#endif
+  if (overflowed) noteFault(row * 2u * countX + countX + column);
+
+  positionOut[i] = nx; positionOut[j] = ny; positionOut[k] = nz;
+  velocityOut[i] = u; velocityOut[j] = v; velocityOut[k] = w;
+  // The tip displacement the patch stage reads (patch_state.h): unchecked, wrapping.
+  displacement[i] = nx - ax;
+  displacement[j] = ny - ay - rod;
+  displacement[k] = nz - az;
+}
+)GLSL";
+
+}  // namespace sg::gpu

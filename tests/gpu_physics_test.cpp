@@ -1,0 +1,317 @@
+// The GPU physics path (sim/gpu/, docs/gpu-physics.md) under OSMesa's compute shaders: the same
+// bits as the CPU's fixed point, tick by tick, on the golden scenes it runs; across save and
+// restore in both directions; on faults (the same report and the same failed state); and
+// operation by operation on particle states drawn over the formats' whole range (RapidCheck),
+// where the device's fault report must be the reference's too.
+#include <gtest/gtest.h>
+#include <rapidcheck.h>
+#include <rapidcheck/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "replay/physics_devices.h"
+#include "sim/gpu/gl_physics.h"
+#include "sim/particles/particle_row.h"
+#include "tests/test_support.h"
+
+namespace sg {
+namespace {
+
+ParticleDeviceProvider& provider() {
+  static const std::unique_ptr<ParticleDeviceProvider> p = [] {
+    std::string error;
+    auto made = gpu::makeOsmesaPhysicsProvider(&error);
+    if (!made) ADD_FAILURE() << error;
+    return made;
+  }();
+  if (!p) throw std::runtime_error("no GPU physics provider");
+  return *p;
+}
+
+std::string hex(uint64_t h) {
+  char buf[19];
+  std::snprintf(buf, sizeof buf, "%016llx", (unsigned long long)h);
+  return buf;
+}
+
+Scenario scenarioNamed(const std::string& name, const std::string& scalar) {
+  Scenario s = loadScenarioFile(test::sourcePath("scenarios/" + name + ".json"));
+  s.scalar = *parseScalarKind(scalar);
+  return s;
+}
+
+std::unique_ptr<SimWorld> onPath(const Scenario& s, PhysicsPath path, int threads = 1) {
+  auto w = makeWorld(s, threads);
+  const std::string why = w->setPhysicsPath(path, &provider());
+  EXPECT_EQ(why, "");
+  EXPECT_EQ(w->physicsPath(), path);
+  return w;
+}
+
+// ---- goldens ---------------------------------------------------------------------------------
+
+struct GoldenRun {
+  std::string scenario, scalar;
+  PhysicsPath path;
+};
+void PrintTo(const GoldenRun& r, std::ostream* os) {
+  *os << r.scenario << " " << r.scalar << " " << physicsPathName(r.path);
+}
+
+class GpuGolden : public ::testing::TestWithParam<GoldenRun> {};
+
+/// 600 ticks beside the CPU: the thesis' readback design compared every tick; the resident path
+/// at ticks spread over the run (each comparison copies its state back, so comparing every tick
+/// would test the readback path again), then the committed golden at tick 600.
+TEST_P(GpuGolden, EveryComparedTickEqualsTheCpuAndTheGolden) {
+  const GoldenRun& r = GetParam();
+  const Scenario s = scenarioNamed(r.scenario, r.scalar);
+  auto cpu = makeWorld(s, 2);
+  auto gpu = onPath(s, r.path);
+  for (int64_t t = 1; t <= 600; ++t) {
+    ASSERT_TRUE(cpu->step(scriptedInput(s, cpu->tick())).ok);
+    ASSERT_TRUE(gpu->step(scriptedInput(s, gpu->tick())).ok) << "tick " << t;
+    const bool compare = r.path == PhysicsPath::GpuReadback || t <= 3 || t % 97 == 0 || t == 600;
+    if (compare) {
+      ASSERT_EQ(hex(gpu->stateHash()), hex(cpu->stateHash())) << "tick " << t;
+    }
+  }
+  std::ifstream in(test::sourcePath("tests/golden/state_hashes.json"));
+  const auto golden = nlohmann::json::parse(in);
+  EXPECT_EQ(hex(gpu->stateHash()), golden.at(r.scenario + "/" + r.scalar).get<std::string>());
+  // The renderer's view (patches) too: derived on the host from the device's displacement.
+  Observation a, b;
+  cpu->observe(a);
+  gpu->observe(b);
+  EXPECT_EQ(a.tipX, b.tipX);
+  EXPECT_EQ(a.tipY, b.tipY);
+  EXPECT_EQ(a.tipZ, b.tipZ);
+}
+
+std::vector<GoldenRun> goldenRuns() {
+  std::vector<GoldenRun> runs;
+  for (const char* scenario : {"thesis-meadow", "hilly-meadow"})
+    for (const char* scalar : {"fx32", "fx16"})
+      for (PhysicsPath path : {PhysicsPath::Gpu, PhysicsPath::GpuReadback}) runs.push_back({scenario, scalar, path});
+  return runs;
+}
+INSTANTIATE_TEST_SUITE_P(Goldens, GpuGolden, ::testing::ValuesIn(goldenRuns()),
+                         [](const ::testing::TestParamInfo<GoldenRun>& info) {
+                           std::string n =
+                               info.param.scenario + "_" + info.param.scalar + "_" + physicsPathName(info.param.path);
+                           for (char& c : n)
+                             if (c == '-') c = '_';
+                           return n;
+                         });
+
+/// The pbd constraint mode and interpolation k = 2 (the patch stage's blend rows), which no golden
+/// scene runs on this path.
+TEST(GpuPhysics, PbdModeAndInterpolationTwoMatchTheCpu) {
+  for (const char* scalar : {"fx32", "fx16"}) {
+    Scenario s = scenarioNamed("thesis-meadow", scalar);
+    s.particles.model = GrassModel::Pbd;
+    s.particles.interpolation = 2;
+    auto cpu = makeWorld(s, 1);
+    auto gpu = onPath(s, PhysicsPath::Gpu);
+    for (int64_t t = 1; t <= 300; ++t) {
+      ASSERT_TRUE(cpu->step(TickInput{}).ok);
+      ASSERT_TRUE(gpu->step(TickInput{}).ok);
+      if (t % 50 == 0) {
+        ASSERT_EQ(hex(gpu->stateHash()), hex(cpu->stateHash())) << scalar << " tick " << t;
+      }
+    }
+  }
+}
+
+// ---- save and restore across devices ---------------------------------------------------------
+
+TEST(GpuPhysics, SaveOnCpuRestoreOnGpuAndBack) {
+  for (const char* scalar : {"fx32", "fx16"}) {
+    const Scenario s = scenarioNamed("hilly-meadow", scalar);
+    auto reference = makeWorld(s, 1);
+    for (int t = 0; t < 240; ++t) ASSERT_TRUE(reference->step(TickInput{}).ok);
+    // CPU 0..80 -> GPU 80..160 -> CPU 160..240.
+    auto cpu = makeWorld(s, 1);
+    for (int t = 0; t < 80; ++t) ASSERT_TRUE(cpu->step(TickInput{}).ok);
+    auto gpu = onPath(s, PhysicsPath::Gpu);
+    gpu->restoreState(cpu->saveState());
+    for (int t = 0; t < 80; ++t) ASSERT_TRUE(gpu->step(TickInput{}).ok);
+    auto back = makeWorld(s, 1);
+    back->restoreState(gpu->saveState());
+    for (int t = 0; t < 80; ++t) ASSERT_TRUE(back->step(TickInput{}).ok);
+    EXPECT_EQ(hex(back->stateHash()), hex(reference->stateHash())) << scalar;
+    // And one world switching paths in the middle of a run.
+    auto switching = makeWorld(s, 1);
+    for (int t = 0; t < 240; ++t) {
+      if (t == 60) {
+        ASSERT_EQ(applyPhysicsPath(*switching, PhysicsPath::Cpu), "");
+        ASSERT_EQ(switching->setPhysicsPath(PhysicsPath::Gpu, &provider()), "");
+      } else if (t == 120) {
+        ASSERT_EQ(switching->setPhysicsPath(PhysicsPath::GpuReadback, &provider()), "");
+      } else if (t == 180) {
+        ASSERT_EQ(switching->setPhysicsPath(PhysicsPath::Cpu, nullptr), "");
+      }
+      ASSERT_TRUE(switching->step(TickInput{}).ok);
+    }
+    EXPECT_EQ(hex(switching->stateHash()), hex(reference->stateHash())) << scalar;
+  }
+}
+
+// ---- faults ----------------------------------------------------------------------------------
+
+/// A meadow whose tufts speed up until fx16 overflows (8000 m/s^2 upward, no damping): the GPU
+/// world fails at the CPU's tick, stage and particle, and holds the CPU's failed state (the
+/// faulting tick is redone by the reference from the device's untouched input).
+TEST(GpuPhysics, AFaultIsTheReferencesReportAndState) {
+  Scenario s = scenarioNamed("thesis-meadow", "fx16");
+  s.particles.acceleration = {Rational{0, 1}, Rational{8000, 1}, Rational{0, 1}};
+  s.particles.damping = Rational{1, 1};
+  for (PhysicsPath path : {PhysicsPath::Gpu, PhysicsPath::GpuReadback}) {
+    auto cpu = makeWorld(s, 1);
+    auto gpu = onPath(s, path);
+    StepResult a, b;
+    for (int t = 0; t < 600 && a.ok; ++t) {
+      a = cpu->step(TickInput{});
+      b = gpu->step(TickInput{});
+      ASSERT_EQ(a.ok, b.ok) << "tick " << t;
+    }
+    ASSERT_FALSE(a.ok) << "the scene was meant to overflow";
+    EXPECT_EQ(b.error.message(), a.error.message());
+    EXPECT_EQ(hex(gpu->stateHash()), hex(cpu->stateHash()));
+    EXPECT_FALSE(gpu->step(TickInput{}).ok);  // failed stays failed
+  }
+}
+
+// ---- what the path does not run --------------------------------------------------------------
+
+TEST(GpuPhysics, ScenesThePathLacksAreRefusedInOneLine) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"thesis-bodies", "no body-grass stage"},
+      {"blade-bodies", "not model 'blade'"},
+      {"wind-fronts", "not model 'blade'"},
+      {"lod-crossing", "no body-grass stage"},
+  };
+  for (const auto& [name, expected] : cases) {
+    auto w = makeWorld(scenarioNamed(name, "fx32"), 1);
+    const std::string why = w->setPhysicsPath(PhysicsPath::Gpu, &provider());
+    EXPECT_NE(why.find(expected), std::string::npos) << name << ": " << why;
+    EXPECT_EQ(why.find('\n'), std::string::npos);
+    EXPECT_EQ(w->physicsPath(), PhysicsPath::Cpu);
+  }
+  auto f = makeWorld(scenarioNamed("thesis-meadow", "float"), 1);
+  EXPECT_NE(f->setPhysicsPath(PhysicsPath::Gpu, &provider()).find("fx32 and fx16"), std::string::npos);
+  // A window without bodies.
+  Scenario window = scenarioNamed("thesis-meadow", "fx32");
+  window.lod.mode = LodMode::Window;
+  window.lod.windowX = window.lod.windowZ = 101;
+  auto l = makeWorld(window, 1);
+  EXPECT_NE(l->setPhysicsPath(PhysicsPath::Gpu, &provider()).find("no level-of-detail window"), std::string::npos);
+  // Swept gust fronts on a rod meadow.
+  Scenario fronts = scenarioNamed("wind-fronts", "fx32");
+  fronts.particles.model = GrassModel::Thesis;
+  auto g = makeWorld(fronts, 1);
+  EXPECT_NE(g->setPhysicsPath(PhysicsPath::Gpu, &provider()).find("row-uniform wind"), std::string::npos);
+}
+
+// ---- the arithmetic, state by state ----------------------------------------------------------
+
+/// A raw value of S whose magnitude is 2^b for b drawn over the whole format (so products,
+/// roots and quotients meet every carry and every overflow boundary), or a value at one of the
+/// format's edges.
+template <class S>
+rc::Gen<typename S::RawType> genRaw() {
+  using Raw = typename S::RawType;
+  constexpr int kBits = int(sizeof(Raw) * 8) - 1;
+  return rc::gen::oneOf(
+      rc::gen::map(rc::gen::tuple(rc::gen::inRange(0, kBits + 1), rc::gen::arbitrary<Raw>()),
+                   [](const std::tuple<int, Raw>& t) {
+                     const auto [bits, noise] = t;
+                     using U = std::make_unsigned_t<Raw>;
+                     const U mask = bits >= kBits ? U(~U(0)) : U((U(1) << bits) - 1);
+                     return Raw(U(noise) & mask) * (noise < 0 ? Raw(-1) : Raw(1));
+                   }),
+      rc::gen::element(std::numeric_limits<Raw>::min(), std::numeric_limits<Raw>::max(), Raw(0), Raw(1), Raw(-1)));
+}
+
+/// Particle states of a small grid (countX x countZ) in which each value is drawn near a base
+/// scale (so most particles step without faulting and the comparison covers their bits), with a
+/// few drawn from the whole range.
+template <class S>
+void deviceMatchesTheReference(bool pbd) {
+  using Raw = typename S::RawType;
+  const int64_t countX = *rc::gen::inRange<int64_t>(1, 40);
+  const int64_t countZ = *rc::gen::inRange<int64_t>(1, 6);
+  const int64_t n = countX * countZ;
+  // Bits of a typical value: up to three quarters of the format, where products still fit.
+  const int scale = *rc::gen::inRange(1, int(sizeof(Raw) * 6) + 1);
+  const auto typical = rc::gen::map(rc::gen::arbitrary<Raw>(), [scale](Raw v) {
+    using U = std::make_unsigned_t<Raw>;
+    return Raw(U(v) & ((U(1) << scale) - 1)) - (Raw(1) << (scale > 0 ? scale - 1 : 0));
+  });
+  const auto value = rc::gen::weightedOneOf<Raw>({{19, typical}, {1, genRaw<S>()}});
+  ParticleArrays<S> p;
+  p.resize(size_t(n));
+  for (auto* v : {&p.px, &p.py, &p.pz, &p.vx, &p.vy, &p.vz, &p.anchorX, &p.anchorY, &p.anchorZ})
+    for (S& x : *v) x = S::fromRaw(*value);
+  ParticleConstants<S> c;
+  c.dt = S::fromRaw(*value);
+  c.dampingPerTick = S::fromRaw(*value);
+  c.rodLength = S::fromRaw(*rc::gen::suchThat(value, [](Raw v) { return v > 0; }));
+  c.invDt = S::fromRaw(*value);
+  std::vector<S> dvx(static_cast<size_t>(countZ)), dvy(dvx), dvz(dvx);
+  for (auto* v : {&dvx, &dvy, &dvz})
+    for (S& x : *v) x = S::fromRaw(*value);
+
+  // The reference: row by row in storage order, stopping at the first fault, as the world does.
+  ParticleArrays<S> ref = p;
+  std::vector<S> rdx(static_cast<size_t>(n)), rdy(rdx), rdz(rdx);
+  RowFault expected;
+  uint32_t expectedBits = 0;
+  takeFixedFaults();
+  for (int64_t r = 0; r < countZ && expected.particle < 0; ++r) {
+    const int64_t b = r * countX, e = b + countX;
+    expected = pbd ? advanceParticleRowScalar<S, true>(ref, b, e, dvx[size_t(r)], dvy[size_t(r)], dvz[size_t(r)], c,
+                                                       rdx, rdy, rdz)
+                   : advanceParticleRowScalar<S, false>(ref, b, e, dvx[size_t(r)], dvy[size_t(r)], dvz[size_t(r)], c,
+                                                        rdx, rdy, rdz);
+    if (expected.particle >= 0) expectedBits = takeFixedFaults();
+  }
+  takeFixedFaults();
+
+  std::string error;
+  std::unique_ptr<ParticleDevice<S>> device;
+  if constexpr (std::is_same_v<S, Fx32>)
+    device = provider().makeFx32(countX, countZ, pbd, &error);
+  else
+    device = provider().makeFx16(countX, countZ, pbd, &error);
+  RC_ASSERT(device != nullptr);
+  device->upload(p);
+  uint32_t bits = 0;
+  const RowFault got = device->advance(dvx, dvy, dvz, c, &bits);
+  RC_ASSERT(got.particle == expected.particle);
+  ParticleArrays<S> out = p;
+  std::vector<S> dx(static_cast<size_t>(n)), dy(dx), dz(dx);
+  device->download(out, &dx, &dy, &dz);
+  if (expected.particle >= 0) {
+    RC_ASSERT(got.stage == expected.stage);
+    RC_ASSERT(bits == expectedBits);
+    RC_ASSERT(out.px == p.px && out.vz == p.vz);  // the tick's input, kept for the reference to redo
+    return;
+  }
+  RC_TAG("no fault");
+  RC_ASSERT(out.px == ref.px && out.py == ref.py && out.pz == ref.pz);
+  RC_ASSERT(out.vx == ref.vx && out.vy == ref.vy && out.vz == ref.vz);
+  RC_ASSERT(dx == rdx && dy == rdy && dz == rdz);
+}
+
+RC_GTEST_PROP(GpuArithmetic, Fx32PassIsTheReference, ()) {
+  deviceMatchesTheReference<Fx32>(*rc::gen::arbitrary<bool>());
+}
+RC_GTEST_PROP(GpuArithmetic, Fx16PassIsTheReference, ()) {
+  deviceMatchesTheReference<Fx16>(*rc::gen::arbitrary<bool>());
+}
+
+}  // namespace
+}  // namespace sg
