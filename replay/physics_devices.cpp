@@ -3,7 +3,10 @@
 namespace sg {
 namespace {
 GpuPhysicsFactory gFactory = nullptr;
-std::unique_ptr<ParticleDeviceProvider> gProvider;
+// Made once and never destroyed: the context lives as long as the process. Destroying it from a
+// static destructor at exit raced Mesa's own teardown (OSMesaMakeCurrent crashed in about one
+// exit in twenty when stdout was a pipe).
+ParticleDeviceProvider* gProvider = nullptr;
 std::string gProviderError;
 bool gTried = false;
 }  // namespace
@@ -17,10 +20,10 @@ ParticleDeviceProvider* gpuPhysicsProvider(std::string* error) {
   }
   if (!gTried) {  // one context per process, kept for its lifetime
     gTried = true;
-    gProvider = gFactory(&gProviderError);
+    gProvider = gFactory(&gProviderError).release();
   }
   if (!gProvider) *error = gProviderError;
-  return gProvider.get();
+  return gProvider;
 }
 
 std::optional<PhysicsPath> parsePhysicsPath(const std::string& text) {

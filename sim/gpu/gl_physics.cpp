@@ -2,6 +2,8 @@
 
 #include <GL/glew.h>
 
+#include <algorithm>
+#include <array>
 #include <cstring>
 #include <type_traits>
 
@@ -56,38 +58,44 @@ GLuint buildProgram(const std::string& source, std::string* error) {
 }
 
 // Shader storage bindings (particle_pass_glsl.h).
-enum Binding : GLuint { kPositionIn, kVelocityIn, kPositionOut, kVelocityOut, kAnchor, kDisplacement, kTick, kFault };
+enum Binding : GLuint {
+  kPositionIn,
+  kVelocityIn,
+  kPositionOut,
+  kVelocityOut,
+  kAnchor,
+  kDisplacement,
+  kTick,
+  kFault,
+  kRuns,
+  kTrampleIn,
+  kTrampleOut
+};
 
-/// One world's particles in shader storage buffers, and the pass over them. Positions and
-/// velocities are double-buffered: a pass reads set `current_` and writes the other, which
-/// becomes current only when the pass did not fault.
+/// One world's particles in shader storage buffers, and the pass over them. Positions,
+/// velocities and trample levels are double-buffered: a pass reads set `current_` and writes the
+/// other, which becomes current only when the pass did not fault.
 template <class S>
 class GlParticleDevice final : public ParticleDevice<S> {
   using Raw = typename S::RawType;
   static_assert(sizeof(S) == sizeof(Raw) && std::is_trivially_copyable_v<S>, "Fixed is its raw value");
 
  public:
-  GlParticleDevice(std::shared_ptr<ComputeContext> context, GLuint program, int64_t countX, int64_t countZ)
-      : context_(std::move(context)), program_(program), countX_(countX), countZ_(countZ) {
-    glCreateBuffers(2, position_);
-    glCreateBuffers(2, velocity_);
-    glCreateBuffers(1, &anchor_);
-    glCreateBuffers(1, &displacement_);
-    glCreateBuffers(1, &tickBuffer_);
-    glCreateBuffers(1, &fault_);
+  GlParticleDevice(std::shared_ptr<ComputeContext> context, GLuint program, int64_t countX, int64_t countZ,
+                   bool tramples)
+      : context_(std::move(context)), program_(program), countX_(countX), countZ_(countZ), tramples_(tramples) {
+    for (GLuint* b : buffers()) glCreateBuffers(1, b);
     for (GLuint b : {position_[0], position_[1], velocity_[0], velocity_[1], anchor_, displacement_})
       glNamedBufferData(b, 3 * arrayBytes(), nullptr, GL_DYNAMIC_COPY);
-    glNamedBufferData(tickBuffer_, GLsizeiptr(4 + 3 * countZ) * GLsizeiptr(sizeof(Raw)), nullptr, GL_STREAM_DRAW);
+    for (GLuint b : trample_) glNamedBufferData(b, tramples ? arrayBytes() : 16, nullptr, GL_DYNAMIC_COPY);
     glNamedBufferData(fault_, sizeof(GLuint), nullptr, GL_STREAM_READ);
-    tick_.resize(size_t(4 + 3 * countZ));
     countXLocation_ = glGetUniformLocation(program_, "countX");
+    countZLocation_ = glGetUniformLocation(program_, "countZ");
     countLocation_ = glGetUniformLocation(program_, "count");
   }
   ~GlParticleDevice() override {  // the program is the provider's
     context_->makeCurrent();
-    for (GLuint b :
-         {position_[0], position_[1], velocity_[0], velocity_[1], anchor_, displacement_, tickBuffer_, fault_})
-      glDeleteBuffers(1, &b);
+    for (GLuint* b : buffers()) glDeleteBuffers(1, b);
   }
   GlParticleDevice(const GlParticleDevice&) = delete;
   GlParticleDevice& operator=(const GlParticleDevice&) = delete;
@@ -99,34 +107,48 @@ class GlParticleDevice final : public ParticleDevice<S> {
     put(position_[current_], {&p.px, &p.py, &p.pz});
     put(velocity_[current_], {&p.vx, &p.vy, &p.vz});
     put(anchor_, {&p.anchorX, &p.anchorY, &p.anchorZ});
+    if (tramples_) put(trample_[current_], {&p.trample});
   }
 
-  RowFault advance(const std::vector<S>& dvx, const std::vector<S>& dvy, const std::vector<S>& dvz,
-                   const ParticleConstants<S>& c, uint32_t* faultBits) override {
+  RowFault advance(const DeviceWind<S>& wind, const ParticleConstants<S>& c, uint32_t* faultBits) override {
     context_->makeCurrent();
-    tick_[0] = c.dt.raw();
-    tick_[1] = c.dampingPerTick.raw();
-    tick_[2] = c.rodLength.raw();
-    tick_[3] = c.invDt.raw();
-    for (int64_t r = 0; r < countZ_; ++r) {
-      tick_[size_t(4 + 3 * r)] = dvx[size_t(r)].raw();
-      tick_[size_t(5 + 3 * r)] = dvy[size_t(r)].raw();
-      tick_[size_t(6 + 3 * r)] = dvz[size_t(r)].raw();
+    const size_t runCount = wind.runBegin.size();
+    tick_.assign({c.dt.raw(), c.dampingPerTick.raw(), c.rodLength.raw(), c.invDt.raw(), c.bladeStiffnessDt.raw(),
+                  c.bladeDampingPerTick.raw(), c.trampleDecayPerTick.raw(), c.invRodLength.raw()});
+    for (size_t k = 0; k < runCount; ++k) {
+      tick_.push_back(wind.dvx[k].raw());
+      tick_.push_back(wind.dvy[k].raw());
+      tick_.push_back(wind.dvz[k].raw());
     }
-    glNamedBufferSubData(tickBuffer_, 0, GLsizeiptr(tick_.size() * sizeof(Raw)), tick_.data());
+    runs_.assign(wind.rowFirstRun.begin(), wind.rowFirstRun.end());
+    for (int64_t r = 0; r < countZ_; ++r) {  // each run as [begin, end)
+      const int32_t first = wind.rowFirstRun[size_t(r)], end = wind.rowFirstRun[size_t(r) + 1];
+      for (int32_t k = first; k < end; ++k) {
+        runs_.push_back(wind.runBegin[size_t(k)]);
+        runs_.push_back(k + 1 < end ? wind.runBegin[size_t(k) + 1] : int32_t(countX_));
+      }
+    }
+    replaceContents(tickBuffer_, tick_, &tickCapacity_);
+    replaceContents(runBuffer_, runs_, &runCapacity_);
     const GLuint none = 0xFFFFFFFFu;
     glNamedBufferSubData(fault_, 0, sizeof none, &none);
     glUseProgram(program_);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kPositionIn, position_[current_]);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVelocityIn, velocity_[current_]);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kPositionOut, position_[1 - current_]);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVelocityOut, velocity_[1 - current_]);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kAnchor, anchor_);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kDisplacement, displacement_);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTick, tickBuffer_);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kFault, fault_);
+    const GLuint next = 1 - current_;
+    const std::pair<Binding, GLuint> bindings[] = {{kPositionIn, position_[current_]},
+                                                   {kVelocityIn, velocity_[current_]},
+                                                   {kPositionOut, position_[next]},
+                                                   {kVelocityOut, velocity_[next]},
+                                                   {kAnchor, anchor_},
+                                                   {kDisplacement, displacement_},
+                                                   {kTick, tickBuffer_},
+                                                   {kFault, fault_},
+                                                   {kRuns, runBuffer_},
+                                                   {kTrampleIn, trample_[current_]},
+                                                   {kTrampleOut, trample_[next]}};
+    for (const auto& [binding, buffer] : bindings) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer);
     const int64_t n = countX_ * countZ_;
     glUniform1ui(countXLocation_, GLuint(countX_));
+    glUniform1ui(countZLocation_, GLuint(countZ_));
     glUniform1ui(countLocation_, GLuint(n));
     glDispatchCompute(GLuint((n + 255) / 256), 1, 1);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
@@ -136,19 +158,18 @@ class GlParticleDevice final : public ParticleDevice<S> {
     glGetNamedBufferSubData(fault_, 0, sizeof key, &key);
     *faultBits = 0;
     if (key == none) {
-      current_ = 1 - current_;
+      current_ = next;
       return {};
     }
     *faultBits = kFixedFaultOverflow;  // the only fault the pass can raise (no d = 0 division, no negative root)
-    const int64_t row = int64_t(key) / (2 * countX_), rest = int64_t(key) % (2 * countX_);
-    const bool projection = rest >= countX_;
-    return {row * countX_ + (projection ? rest - countX_ : rest), projection ? Stage::Constraints : Stage::Integrate};
+    return decode(key, wind);
   }
 
   void download(ParticleArrays<S>& p, std::vector<S>* dx, std::vector<S>* dy, std::vector<S>* dz) override {
     context_->makeCurrent();
     get(position_[current_], {&p.px, &p.py, &p.pz});
     get(velocity_[current_], {&p.vx, &p.vy, &p.vz});
+    if (tramples_) get(trample_[current_], {&p.trample});
     if (dx) get(displacement_, {dx, dy, dz});
   }
 
@@ -169,13 +190,52 @@ class GlParticleDevice final : public ParticleDevice<S> {
     }
   }
 
+  /// Replaces a per-tick buffer's contents, growing it when the tick holds more (gust fronts
+  /// split rows into runs).
+  template <class T>
+  static void replaceContents(GLuint buffer, const std::vector<T>& values, GLsizeiptr* capacity) {
+    const GLsizeiptr bytes = GLsizeiptr(values.size() * sizeof(T));
+    if (bytes > *capacity) {
+      *capacity = std::max<GLsizeiptr>(bytes, 2 * *capacity);
+      glNamedBufferData(buffer, *capacity, nullptr, GL_STREAM_DRAW);
+    }
+    glNamedBufferSubData(buffer, 0, bytes, values.data());
+  }
+  /// The particle and stage of fault key `key` (particle_pass_glsl.h): after the row's base
+  /// row 2 countX, run k covers [2 begin_k, 2 end_k), integration faults before projection ones.
+  RowFault decode(GLuint key, const DeviceWind<S>& wind) const {
+    const int64_t row = int64_t(key) / (2 * countX_), rest = int64_t(key) % (2 * countX_);
+    const int32_t first = wind.rowFirstRun[size_t(row)], end = wind.rowFirstRun[size_t(row) + 1];
+    for (int32_t k = first; k < end; ++k) {
+      const int64_t begin = wind.runBegin[size_t(k)];
+      const int64_t stop = k + 1 < end ? int64_t(wind.runBegin[size_t(k) + 1]) : countX_;
+      if (rest >= 2 * stop) continue;
+      const int64_t offset = rest - 2 * begin;
+      const bool projection = offset >= stop - begin;
+      return {row * countX_ + begin + (projection ? offset - (stop - begin) : offset),
+              projection ? Stage::Constraints : Stage::Integrate};
+    }
+    return {row * countX_, Stage::Integrate};  // unreachable: the runs cover the row
+  }
+
+  std::array<GLuint*, 11> buffers() {
+    return {&position_[0], &position_[1],  &velocity_[0], &velocity_[1], &trample_[0], &trample_[1],
+            &anchor_,      &displacement_, &tickBuffer_,  &runBuffer_,   &fault_};
+  }
+
   std::shared_ptr<ComputeContext> context_;
   GLuint program_ = 0;
-  GLuint position_[2] = {}, velocity_[2] = {}, anchor_ = 0, displacement_ = 0, tickBuffer_ = 0, fault_ = 0;
-  int current_ = 0;  ///< which position and velocity set holds the state
-  GLint countXLocation_ = -1, countLocation_ = -1;
+  GLuint position_[2] = {}, velocity_[2] = {};  ///< x, y and z in each
+  GLuint trample_[2] = {};                      ///< 16 bytes each without trampling
+  GLuint anchor_ = 0, displacement_ = 0;        ///< x, y and z in each
+  GLuint tickBuffer_ = 0, runBuffer_ = 0, fault_ = 0;
+  GLsizeiptr tickCapacity_ = 0, runCapacity_ = 0;
+  GLuint current_ = 0;  ///< which position, velocity and trample set holds the state
+  GLint countXLocation_ = -1, countZLocation_ = -1, countLocation_ = -1;
   int64_t countX_ = 0, countZ_ = 0;
+  bool tramples_ = false;
   std::vector<Raw> tick_;
+  std::vector<int32_t> runs_;
 };
 
 class OsmesaPhysicsProvider final : public ParticleDeviceProvider {
@@ -184,23 +244,25 @@ class OsmesaPhysicsProvider final : public ParticleDeviceProvider {
   ~OsmesaPhysicsProvider() override {
     context_->makeCurrent();
     for (auto& byModel : programs_)
-      for (GLuint p : byModel)
-        if (p) glDeleteProgram(p);
+      for (auto& byTrample : byModel)
+        for (GLuint p : byTrample)
+          if (p) glDeleteProgram(p);
   }
 
-  std::unique_ptr<ParticleDevice<Fx32>> makeFx32(int64_t countX, int64_t countZ, bool pbd,
+  std::unique_ptr<ParticleDevice<Fx32>> makeFx32(int64_t countX, int64_t countZ, GrassModel model, bool tramples,
                                                  std::string* error) override {
-    return make<Fx32>(countX, countZ, pbd, error);
+    return make<Fx32>(countX, countZ, model, tramples, error);
   }
-  std::unique_ptr<ParticleDevice<Fx16>> makeFx16(int64_t countX, int64_t countZ, bool pbd,
+  std::unique_ptr<ParticleDevice<Fx16>> makeFx16(int64_t countX, int64_t countZ, GrassModel model, bool tramples,
                                                  std::string* error) override {
-    return make<Fx16>(countX, countZ, pbd, error);
+    return make<Fx16>(countX, countZ, model, tramples, error);
   }
   std::string describe() const override { return context_->description; }
 
  private:
   template <class S>
-  std::unique_ptr<ParticleDevice<S>> make(int64_t countX, int64_t countZ, bool pbd, std::string* error) {
+  std::unique_ptr<ParticleDevice<S>> make(int64_t countX, int64_t countZ, GrassModel model, bool tramples,
+                                          std::string* error) {
     context_->makeCurrent();
     const int64_t n = countX * countZ;
     GLint64 maxBlock = 0;
@@ -211,18 +273,20 @@ class OsmesaPhysicsProvider final : public ParticleDeviceProvider {
                "-byte storage buffers; this device allows " + std::to_string(int64_t(maxBlock));
       return nullptr;
     }
-    // One program per format and constraint mode, compiled on first use and kept.
-    GLuint& program = programs_[std::is_same_v<S, Fx32> ? 0 : 1][pbd ? 1 : 0];
+    // One program per format, model and trampling, compiled on first use and kept.
+    const int modelIndex = model == GrassModel::Pbd ? 1 : model == GrassModel::Blade ? 2 : 0;
+    tramples = tramples && model == GrassModel::Blade;
+    GLuint& program = programs_[std::is_same_v<S, Fx32> ? 0 : 1][modelIndex][tramples ? 1 : 0];
     if (!program) {
       const std::string prelude = std::string("#version 450\n#extension GL_ARB_gpu_shader_int64 : require\n") +
-                                  "#define FX32 " + (std::is_same_v<S, Fx32> ? "1" : "0") + "\n#define PBD " +
-                                  (pbd ? "1" : "0") + "\n";
+                                  "#define FX32 " + (std::is_same_v<S, Fx32> ? "1" : "0") + "\n#define MODEL " +
+                                  std::to_string(modelIndex) + "\n#define TRAMPLE " + (tramples ? "1" : "0") + "\n";
       program = buildProgram(prelude + kParticlePassGlsl, error);
       if (!program) return nullptr;
     }
     while (glGetError() != GL_NO_ERROR) {
     }
-    auto device = std::make_unique<GlParticleDevice<S>>(context_, program, countX, countZ);
+    auto device = std::make_unique<GlParticleDevice<S>>(context_, program, countX, countZ, tramples);
     if (!device->ok()) {
       *error = "GPU physics: the device could not allocate buffers for " + std::to_string(n) + " particles";
       return nullptr;
@@ -231,7 +295,7 @@ class OsmesaPhysicsProvider final : public ParticleDeviceProvider {
   }
 
   std::shared_ptr<ComputeContext> context_;
-  GLuint programs_[2][2] = {};  ///< [fx32, fx16][thesis, pbd]
+  GLuint programs_[2][3][2] = {};  ///< [fx32, fx16][thesis, pbd, blade][trample]
 };
 
 }  // namespace

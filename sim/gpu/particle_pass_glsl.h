@@ -5,7 +5,7 @@
 // Q32.32's 128-bit product built from 32 x 32 -> 64 partial products; L / |d| and |d| are guessed
 // in double precision and then settled in exact integer arithmetic (the guess only decides how
 // many correction steps run, never the result). The prelude gl_physics.cpp puts before this text
-// defines FX32 or FX16 and PBD (0 or 1).
+// defines FX32 (1: Q32.32, 0: Q16.16), MODEL (0 thesis, 1 pbd, 2 blade) and TRAMPLE (0 or 1).
 #pragma once
 
 namespace sg::gpu {
@@ -30,12 +30,21 @@ layout(std430, binding = 2) writeonly buffer PositionOut { RAW positionOut[]; };
 layout(std430, binding = 3) writeonly buffer VelocityOut { RAW velocityOut[]; };
 layout(std430, binding = 4) readonly buffer Anchor { RAW anchor[]; };
 layout(std430, binding = 5) writeonly buffer Displacement { RAW displacement[]; };
-// [0..3]: dt, damping per tick, rod length, 1/dt; then (a + F/m) dt of row r at 4 + 3r (x, y, z).
+// [0..7]: dt, damping per tick, rod length, 1/dt, blade stiffness dt, blade damping per tick,
+// trample decay per tick, 1/L (ParticleConstants); then run k's (a + F/m) dt at 8 + 3k (x, y, z).
 layout(std430, binding = 6) readonly buffer Tick { RAW tickData[]; };
-// The smallest fault key: row * 2 countX + (projection ? countX : 0) + column (0xffffffff: none).
+// The smallest fault key (0xffffffff: none); see faultKey() below.
 layout(std430, binding = 7) buffer Fault { uint faultKey; };
+// [0..countZ]: row r's wind runs are [runs[r], runs[r + 1]); run k covers columns
+// [runs[countZ + 1 + 2k], runs[countZ + 2 + 2k]).
+layout(std430, binding = 8) readonly buffer Runs { uint runs[]; };
+#if TRAMPLE
+layout(std430, binding = 9) readonly buffer TrampleIn { RAW trampleIn[]; };
+layout(std430, binding = 10) writeonly buffer TrampleOut { RAW trampleOut[]; };
+#endif
 
 uniform uint countX;
+uniform uint countZ;
 uniform uint count;
 
 bool overflowed;  // this invocation's fault bit (Fixed's kFixedFaultOverflow)
@@ -188,15 +197,69 @@ void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= count) return;
   uint row = i / countX, column = i - row * countX;
-  RAW dt = tickData[0], damping = tickData[1], rod = tickData[2], invDt = tickData[3];
-  RAW dvx = tickData[4 + 3 * row], dvy = tickData[5 + 3 * row], dvz = tickData[6 + 3 * row];
-  uint j = i + count, k = j + count;  // y and z of particle i
-  RAW x = positionIn[i], y = positionIn[j], z = positionIn[k];
-  RAW u = velocityIn[i], v = velocityIn[j], w = velocityIn[k];
-
-  // Stage 3, integrate.h: explicit order for "thesis", symplectic for "pbd".
+  RAW dt = tickData[0], rod = tickData[2], invDt = tickData[3];
+  // The run of this row whose columns hold this particle: the CPU advances a row run by run, in
+  // column order, so its fault order is (row, run, stage, column). The key below orders the same
+  // way: run k of the row covers keys [2 begin_k, 2 end_k) after the row's base.
+  // (Each run's end is stored beside its begin. Read instead as `k + 1 < endRun ? <the next run's
+  // begin> : countX`, it came out 0 for a row's first run on llvmpipe (Mesa 22.3.6), though the
+  // loop above had just read the same element as non-zero; tests/gpu_physics_test.cpp's
+  // properties found it.)
+  uint endRun = runs[row + 1u], k = runs[row];
+  while (k + 1u < endRun && runs[countZ + 1u + 2u * (k + 1u)] <= column) ++k;
+  uint pieceBegin = runs[countZ + 1u + 2u * k];
+  uint pieceEnd = runs[countZ + 2u + 2u * k];
+  uint integrationKey = row * 2u * countX + 2u * pieceBegin + (column - pieceBegin);
+  uint projectionKey = integrationKey + (pieceEnd - pieceBegin);
+  RAW dvx = tickData[8u + 3u * k], dvy = tickData[9u + 3u * k], dvz = tickData[10u + 3u * k];
+  uint j = i + count, l = j + count;  // y and z of particle i
+  RAW x = positionIn[i], y = positionIn[j], z = positionIn[l];
+  RAW u = velocityIn[i], v = velocityIn[j], w = velocityIn[l];
+  RAW ax = anchor[i], ay = anchor[j], az = anchor[l];
+  RAW nx, ny, nz;
   overflowed = false;
-#if !PBD
+#if MODEL == 2
+  // blade.h: one loop, every fault the integration's.
+  RAW stiffness = tickData[4], damping = tickData[5], decay = tickData[6], invRod = tickData[7];
+#if TRAMPLE
+  RAW trample = trampleIn[i];
+  stiffness = mulChecked(stiffness, subChecked(RAW(1) << FRAC, trample));
+  trampleOut[i] = trample > decay ? subChecked(trample, decay) : RAW(0);
+#endif
+  RAW rx = subChecked(x, ax), ry = subChecked(y, ay), rz = subChecked(z, az);
+  RAW gx = subChecked(dvx, mulChecked(stiffness, rx));
+  RAW gy = subChecked(dvy, mulChecked(stiffness, subChecked(ry, rod)));
+  RAW gz = subChecked(dvz, mulChecked(stiffness, rz));
+  RAW along = mulChecked(
+      mulChecked(addChecked(addChecked(mulChecked(gx, rx), mulChecked(gy, ry)), mulChecked(gz, rz)), invRod), invRod);
+  gx = subChecked(gx, mulChecked(rx, along));
+  gy = subChecked(gy, mulChecked(ry, along));
+  gz = subChecked(gz, mulChecked(rz, along));
+  u = mulChecked(addChecked(u, gx), damping);
+  v = mulChecked(addChecked(v, gy), damping);
+  w = mulChecked(addChecked(w, gz), damping);
+  RAW predictedX = addChecked(x, mulChecked(u, dt)), predictedY = addChecked(y, mulChecked(v, dt)),
+      predictedZ = addChecked(z, mulChecked(w, dt));
+  RAW ex = subChecked(predictedX, ax), ey = predictedY > ay ? subChecked(predictedY, ay) : RAW(0),
+      ez = subChecked(predictedZ, az);
+  RAW len = length3(ex, ey, ez);
+  nx = ax;
+  ny = addChecked(ay, rod);  // computed whether or not it is used, as the reference does
+  nz = az;
+  if (len != RAW(0)) {
+    RAW scale = divChecked(rod, len);
+    nx = addChecked(ax, mulChecked(ex, scale));
+    ny = addChecked(ay, mulChecked(ey, scale));
+    nz = addChecked(az, mulChecked(ez, scale));
+  }
+  u = addChecked(u, mulChecked(subChecked(nx, predictedX), invDt));
+  v = addChecked(v, mulChecked(subChecked(ny, predictedY), invDt));
+  w = addChecked(w, mulChecked(subChecked(nz, predictedZ), invDt));
+  if (overflowed) noteFault(integrationKey);
+#else
+  RAW damping = tickData[1];
+  // Stage 3, integrate.h: explicit order for "thesis", symplectic for "pbd".
+#if MODEL == 0
   x = addChecked(x, mulChecked(u, dt));
   y = addChecked(y, mulChecked(v, dt));
   z = addChecked(z, mulChecked(w, dt));
@@ -204,19 +267,17 @@ void main() {
   u = mulChecked(addChecked(u, dvx), damping);
   v = mulChecked(addChecked(v, dvy), damping);
   w = mulChecked(addChecked(w, dvz), damping);
-#if PBD
+#if MODEL == 1
   x = addChecked(x, mulChecked(u, dt));
   y = addChecked(y, mulChecked(v, dt));
   z = addChecked(z, mulChecked(w, dt));
 #endif
-  if (overflowed) noteFault(row * 2u * countX + column);
+  if (overflowed) noteFault(integrationKey);
 
   // Stage 4, rod_constraint.h.
   overflowed = false;
-  RAW ax = anchor[i], ay = anchor[j], az = anchor[k];
   RAW dx = subChecked(x, ax), dy = subChecked(y, ay), dz = subChecked(z, az);
   RAW len = length3(dx, dy, dz);
-  RAW nx, ny, nz;
   if (len == RAW(0)) {
     nx = ax;
     ny = addChecked(ay, rod);
@@ -227,19 +288,20 @@ void main() {
     ny = addChecked(ay, mulChecked(dy, scale));
     nz = addChecked(az, mulChecked(dz, scale));
   }
-#if PBD
+#if MODEL == 1
   u = addChecked(u, mulChecked(subChecked(nx, x), invDt));
   v = addChecked(v, mulChecked(subChecked(ny, y), invDt));
   w = addChecked(w, mulChecked(subChecked(nz, z), invDt));
 #endif
-  if (overflowed) noteFault(row * 2u * countX + countX + column);
+  if (overflowed) noteFault(projectionKey);
+#endif
 
-  positionOut[i] = nx; positionOut[j] = ny; positionOut[k] = nz;
-  velocityOut[i] = u; velocityOut[j] = v; velocityOut[k] = w;
+  positionOut[i] = nx; positionOut[j] = ny; positionOut[l] = nz;
+  velocityOut[i] = u; velocityOut[j] = v; velocityOut[l] = w;
   // The tip displacement the patch stage reads (patch_state.h): unchecked, wrapping.
   displacement[i] = nx - ax;
   displacement[j] = ny - ay - rod;
-  displacement[k] = nz - az;
+  displacement[l] = nz - az;
 }
 )GLSL";
 

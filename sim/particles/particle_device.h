@@ -15,23 +15,33 @@
 #include "sim/particles/particle_kernel.h"
 #include "sim/particles/particle_row.h"
 #include "sim/particles/particles.h"
+#include "sim/scenario/scenario.h"
 
 namespace sg {
+
+/// One tick's wind as a device reads it: each storage row's runs of columns under one increment
+/// (a + F/m) dt, in column order (the whole row as one run where the wind is row-uniform).
+template <class S>
+struct DeviceWind {
+  std::vector<int32_t> rowFirstRun;  ///< countZ + 1 entries: row r's runs are [rowFirstRun[r], rowFirstRun[r + 1])
+  std::vector<int32_t> runBegin;     ///< per run: the storage column it starts at (it ends where the next begins)
+  std::vector<S> dvx, dvy, dvz;      ///< per run (m/s)
+};
 
 /// One device's copy of a world's particles (countX x countZ, storage order).
 template <class S>
 class ParticleDevice {
  public:
   virtual ~ParticleDevice() = default;
-  /// Copies the host's particle state and anchors to the device (the host is the truth).
+  /// Copies the host's particle state (trample levels included) and anchors to the device (the
+  /// host is the truth).
   virtual void upload(const ParticleArrays<S>& p) = 0;
-  /// One fused pass over every particle; storage row r moves under (dvx[r], dvy[r], dvz[r]),
-  /// its (a + F/m) dt. Returns the fault the CPU reference reports (the first faulting row's;
-  /// within it the integration's first faulting particle before any projection fault), with
-  /// the fixed-point fault bits in *faultBits. A pass that faults keeps the device's state as it
-  /// was before the pass (the world then redoes the tick on the CPU, which stops at the fault).
-  virtual RowFault advance(const std::vector<S>& dvx, const std::vector<S>& dvy, const std::vector<S>& dvz,
-                           const ParticleConstants<S>& c, uint32_t* faultBits) = 0;
+  /// One fused pass over every particle under `wind`. Returns the fault the CPU reference reports
+  /// (the first faulting row's; within a row, run by run in column order, a run's first
+  /// integration fault before any projection fault), with the fixed-point fault bits in
+  /// *faultBits. A pass that faults keeps the device's state as it was before the pass (the world
+  /// then redoes the tick on the CPU, which stops at the fault).
+  virtual RowFault advance(const DeviceWind<S>& wind, const ParticleConstants<S>& c, uint32_t* faultBits) = 0;
   /// Copies the device's particle state to the host, and the tip displacement of the last pass
   /// where dx, dy, dz are given.
   virtual void download(ParticleArrays<S>& p, std::vector<S>* dx, std::vector<S>* dy, std::vector<S>* dz) = 0;
@@ -41,12 +51,12 @@ class ParticleDevice {
 class ParticleDeviceProvider {
  public:
   virtual ~ParticleDeviceProvider() = default;
-  /// A device for countX x countZ particles of the rod model (`pbd`: the pbd constraint mode),
-  /// or nullptr with *error set.
-  virtual std::unique_ptr<ParticleDevice<Fx32>> makeFx32(int64_t countX, int64_t countZ, bool pbd,
-                                                         std::string* error) = 0;
-  virtual std::unique_ptr<ParticleDevice<Fx16>> makeFx16(int64_t countX, int64_t countZ, bool pbd,
-                                                         std::string* error) = 0;
+  /// A device for countX x countZ particles of grass model `model` (`tramples`: the blade model
+  /// keeps trample levels), or nullptr with *error set.
+  virtual std::unique_ptr<ParticleDevice<Fx32>> makeFx32(int64_t countX, int64_t countZ, GrassModel model,
+                                                         bool tramples, std::string* error) = 0;
+  virtual std::unique_ptr<ParticleDevice<Fx16>> makeFx16(int64_t countX, int64_t countZ, GrassModel model,
+                                                         bool tramples, std::string* error) = 0;
   /// The device in words ("OpenGL 4.5 compute on llvmpipe (LLVM 15.0.6, 256 bits)").
   virtual std::string describe() const = 0;
 };

@@ -201,6 +201,7 @@ class World final : public SimWorld {
   // changed since the last upload (a restore, a test's edits).
   PhysicsPath physicsPath_ = PhysicsPath::Cpu;
   std::unique_ptr<ParticleDevice<S>> device_;
+  DeviceWind<S> deviceWind_;  ///< the tick's wind as the device reads it (scratch, not state)
   bool deviceAhead_ = false;
   bool hostAhead_ = false;
 };

@@ -9,12 +9,9 @@ std::string World<S>::deviceLimitation() const {
   if constexpr (!ScalarTraits<S>::isFixed) {
     return std::string("the device path runs fx32 and fx16 (this world is ") + scalarName(ScalarTraits<S>::kind) + ")";
   } else {
-    if (model_ == GrassModel::Blade) return "the device path runs the rod models (thesis, pbd), not model 'blade' yet";
     if (!initialBodies_.empty() || !bodies_.empty())
       return "the device path has no body-grass stage yet (this scenario has bodies)";
     if (lodWindow_) return "the device path has no level-of-detail window yet (lod.mode 'window')";
-    if (!windSchedule_.rowUniform())
-      return "the device path runs row-uniform wind only (this schedule has swept gust fronts, wind.schedule[].front)";
     return "";
   }
 }
@@ -32,11 +29,11 @@ std::string World<S>::setPhysicsPath(PhysicsPath path, ParticleDeviceProvider* p
   if constexpr (ScalarTraits<S>::isFixed) {
     std::string error;
     std::unique_ptr<ParticleDevice<S>> device;
-    const bool pbd = model_ == GrassModel::Pbd;
+    const bool tramples = !particles_.trample.empty();
     if constexpr (std::is_same_v<S, Fx32>)
-      device = provider->makeFx32(grid_.countX, grid_.countZ, pbd, &error);
+      device = provider->makeFx32(grid_.countX, grid_.countZ, model_, tramples, &error);
     else
-      device = provider->makeFx16(grid_.countX, grid_.countZ, pbd, &error);
+      device = provider->makeFx16(grid_.countX, grid_.countZ, model_, tramples, &error);
     if (!device) return error.empty() ? "the device could not be set up" : error;
     syncFromDevice();  // from an old device, if any: the host is the truth again
     device_ = std::move(device);
@@ -54,19 +51,48 @@ bool World<S>::deviceParticlePass() {
     device_->upload(particles_);
     hostAhead_ = false;
   }
-  uint32_t faultBits = 0;
-  // The wind stage computed every row's increment on the host (a few values per row); the
-  // device reads them by storage row, which is the lattice row without a window.
-  const RowFault fault = device_->advance(rowAccel_.x, rowAccel_.y, rowAccel_.z, particleConsts_, &faultBits);
-  if (fault.particle >= 0) {
-    // The device kept the tick's input: the CPU reference redoes the tick from it, so a failed
-    // world holds the CPU's state too (the CPU stops the faulting row where it faulted) and its
-    // fault report is the reference's own. The host is the truth until the next upload.
+  // The wind as runs of columns, row by row (a few values per row; computed here on the host as
+  // the CPU pass computes it). Without a window, storage rows and columns are lattice ones.
+  DeviceWind<S>& wind = deviceWind_;
+  wind.rowFirstRun.clear();
+  wind.runBegin.clear();
+  wind.dvx.clear();
+  wind.dvy.clear();
+  wind.dvz.clear();
+  const bool rowUniform = windSchedule_.rowUniform();
+  thread_local std::vector<WindRun<S>> runs;
+  for (int64_t r = 0; r < grid_.countZ; ++r) {
+    wind.rowFirstRun.push_back(int32_t(wind.runBegin.size()));
+    if (rowUniform) {
+      runs.assign(1,
+                  WindRun<S>{0, grid_.countX, rowAccel_.x[size_t(r)], rowAccel_.y[size_t(r)], rowAccel_.z[size_t(r)]});
+    } else {
+      computeRowWind(windSchedule_, windConsts_, tick_, r, 0, grid_.countX, &runs);
+    }
+    for (const WindRun<S>& run : runs) {
+      wind.runBegin.push_back(int32_t(run.begin));
+      wind.dvx.push_back(run.dvx);
+      wind.dvy.push_back(run.dvy);
+      wind.dvz.push_back(run.dvz);
+    }
+  }
+  wind.rowFirstRun.push_back(int32_t(wind.runBegin.size()));
+  // A fault anywhere in the pass (or in the wind above, which the CPU pass meets inside its rows)
+  // hands the tick back: the device kept the tick's input, and the CPU reference redoes the tick
+  // from it, so a failed world holds the CPU's state too (the CPU stops the faulting row where it
+  // faulted) and its fault report is the reference's own. The host is the truth until the next
+  // upload.
+  const auto handBack = [&] {
+    takeFixedFaults();
     device_->download(particles_, nullptr, nullptr, nullptr);
     deviceAhead_ = false;
     hostAhead_ = true;
     return false;
-  }
+  };
+  if (pendingFixedFaults() != 0) return handBack();
+  uint32_t faultBits = 0;
+  const RowFault fault = device_->advance(wind, particleConsts_, &faultBits);
+  if (fault.particle >= 0) return handBack();
   deviceAhead_ = true;
   if (physicsPath_ == PhysicsPath::GpuReadback) {
     // The thesis' design: the state comes back every tick, and the patch stage runs on the host.
