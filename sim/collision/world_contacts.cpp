@@ -142,6 +142,8 @@ bool World<S>::respondToContacts() {
   mowGrass();
   // Grass: pushed out of every body (particle rows in parallel, bodies in id order).
   const GrassPushers<S> pushers = prepareGrassPushers(bodies_, grid_, bodyParticle_);
+  // On a device the pushed rows come to the host and go back (world_device.cpp).
+  if (device_) bringPushedRowsToHost(pushers);
   const bool drag = grassDragDt_ > S(0);
   // Per-row push counts (integers, summed in row order below: the same for any thread count).
   std::vector<int64_t> pushed(drag ? size_t(grid_.countZ) * bodies_.size() : 0, 0);

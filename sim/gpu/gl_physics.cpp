@@ -165,6 +165,21 @@ class GlParticleDevice final : public ParticleDevice<S> {
     return decode(key, wind);
   }
 
+  void downloadRows(ParticleArrays<S>& p, int64_t rowBegin, int64_t rowEnd) override {
+    context_->makeCurrent();
+    const Span rows{rowBegin * countX_, (rowEnd - rowBegin) * countX_};
+    get(position_[current_], {&p.px, &p.py, &p.pz}, rows);
+    get(velocity_[current_], {&p.vx, &p.vy, &p.vz}, rows);
+    if (tramples_) get(trample_[current_], {&p.trample}, rows);
+  }
+  void uploadRows(const ParticleArrays<S>& p, int64_t rowBegin, int64_t rowEnd) override {
+    context_->makeCurrent();
+    const Span rows{rowBegin * countX_, (rowEnd - rowBegin) * countX_};
+    put(position_[current_], {&p.px, &p.py, &p.pz}, rows);
+    put(velocity_[current_], {&p.vx, &p.vy, &p.vz}, rows);
+    if (tramples_) put(trample_[current_], {&p.trample}, rows);
+  }
+
   void download(ParticleArrays<S>& p, std::vector<S>* dx, std::vector<S>* dy, std::vector<S>* dz) override {
     context_->makeCurrent();
     get(position_[current_], {&p.px, &p.py, &p.pz});
@@ -174,18 +189,25 @@ class GlParticleDevice final : public ParticleDevice<S> {
   }
 
  private:
+  /// Particles [first, first + count) of every array of a buffer.
+  struct Span {
+    int64_t first = 0, count = -1;  ///< count < 0: all
+  };
   GLsizeiptr arrayBytes() const { return GLsizeiptr(countX_ * countZ_) * GLsizeiptr(sizeof(Raw)); }
-  void put(GLuint buffer, std::initializer_list<const std::vector<S>*> arrays) {
-    GLintptr at = 0;
+  /// The arrays of one buffer (x, y, z one after the other), or the span of each.
+  void put(GLuint buffer, std::initializer_list<const std::vector<S>*> arrays, Span span = {}) {
+    const int64_t count = span.count < 0 ? countX_ * countZ_ : span.count;
+    GLintptr at = GLintptr(span.first) * GLintptr(sizeof(Raw));
     for (const std::vector<S>* a : arrays) {
-      glNamedBufferSubData(buffer, at, arrayBytes(), a->data());
+      glNamedBufferSubData(buffer, at, GLsizeiptr(count) * GLsizeiptr(sizeof(Raw)), a->data() + span.first);
       at += arrayBytes();
     }
   }
-  void get(GLuint buffer, std::initializer_list<std::vector<S>*> arrays) {
-    GLintptr at = 0;
+  void get(GLuint buffer, std::initializer_list<std::vector<S>*> arrays, Span span = {}) {
+    const int64_t count = span.count < 0 ? countX_ * countZ_ : span.count;
+    GLintptr at = GLintptr(span.first) * GLintptr(sizeof(Raw));
     for (std::vector<S>* a : arrays) {
-      glGetNamedBufferSubData(buffer, at, arrayBytes(), a->data());
+      glGetNamedBufferSubData(buffer, at, GLsizeiptr(count) * GLsizeiptr(sizeof(Raw)), a->data() + span.first);
       at += arrayBytes();
     }
   }

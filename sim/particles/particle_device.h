@@ -42,6 +42,10 @@ class ParticleDevice {
   /// *faultBits. A pass that faults keeps the device's state as it was before the pass (the world
   /// then redoes the tick on the CPU, which stops at the fault).
   virtual RowFault advance(const DeviceWind<S>& wind, const ParticleConstants<S>& c, uint32_t* faultBits) = 0;
+  /// Storage rows [rowBegin, rowEnd) of the particle state only (positions, velocities, trample
+  /// levels), each way: the host's body stages push the grass under the bodies (world_device.cpp).
+  virtual void downloadRows(ParticleArrays<S>& p, int64_t rowBegin, int64_t rowEnd) = 0;
+  virtual void uploadRows(const ParticleArrays<S>& p, int64_t rowBegin, int64_t rowEnd) = 0;
   /// Copies the device's particle state to the host, and the tip displacement of the last pass
   /// where dx, dy, dz are given.
   virtual void download(ParticleArrays<S>& p, std::vector<S>* dx, std::vector<S>* dy, std::vector<S>* dz) = 0;

@@ -112,6 +112,11 @@ class World final : public SimWorld {
   /// patches from them (the patch stage the device path left to this point). Const: it changes
   /// no state, only where the state is held.
   void syncFromDevice() const;
+  /// Before the host pushes the grass under the bodies: copies the rows the pushers span back from
+  /// the device and marks them for the upload after the push.
+  void bringPushedRowsToHost(const GrassPushers<S>& pushers);
+  /// Uploads the rows in hostRowsAhead_.
+  void flushRowsToDevice();
   /// Records a fixed-point fault of `stage` as the world's failure; returns false.
   bool failWith(Stage stage, uint32_t faults);
   template <class Fn>
@@ -202,6 +207,9 @@ class World final : public SimWorld {
   PhysicsPath physicsPath_ = PhysicsPath::Cpu;
   std::unique_ptr<ParticleDevice<S>> device_;
   DeviceWind<S> deviceWind_;  ///< the tick's wind as the device reads it (scratch, not state)
+  /// Storage row ranges the host's grass push changed since the device's last copy (uploaded
+  /// before the next pass or download).
+  std::vector<std::pair<int64_t, int64_t>> hostRowsAhead_;
   bool deviceAhead_ = false;
   bool hostAhead_ = false;
 };

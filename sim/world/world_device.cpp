@@ -9,8 +9,6 @@ std::string World<S>::deviceLimitation() const {
   if constexpr (!ScalarTraits<S>::isFixed) {
     return std::string("the device path runs fx32 and fx16 (this world is ") + scalarName(ScalarTraits<S>::kind) + ")";
   } else {
-    if (!initialBodies_.empty() || !bodies_.empty())
-      return "the device path has no body-grass stage yet (this scenario has bodies)";
     if (lodWindow_) return "the device path has no level-of-detail window yet (lod.mode 'window')";
     return "";
   }
@@ -21,6 +19,7 @@ std::string World<S>::setPhysicsPath(PhysicsPath path, ParticleDeviceProvider* p
   if (path == PhysicsPath::Cpu) {
     syncFromDevice();
     device_.reset();
+    hostRowsAhead_.clear();
     physicsPath_ = path;
     return "";
   }
@@ -50,7 +49,9 @@ bool World<S>::deviceParticlePass() {
   if (hostAhead_) {
     device_->upload(particles_);
     hostAhead_ = false;
+    hostRowsAhead_.clear();
   }
+  flushRowsToDevice();
   // The wind as runs of columns, row by row (a few values per row; computed here on the host as
   // the CPU pass computes it). Without a window, storage rows and columns are lattice ones.
   DeviceWind<S>& wind = deviceWind_;
@@ -103,11 +104,38 @@ bool World<S>::deviceParticlePass() {
 }
 
 template <class S>
+void World<S>::bringPushedRowsToHost(const GrassPushers<S>& pushers) {
+  // The rows any pusher spans (pushParticlesOutOfBodies skips the others), as ranges.
+  for (int64_t row = 0; row < grid_.countZ;) {
+    const auto spanned = [&](int64_t r) {
+      const int64_t b = grid_.window.latticeRow(r) - pushers.originJ;
+      return pushers.rowStart[size_t(b + 1)] > pushers.rowStart[size_t(b)];
+    };
+    if (!spanned(row)) {
+      ++row;
+      continue;
+    }
+    int64_t end = row + 1;
+    while (end < grid_.countZ && spanned(end)) ++end;
+    if (deviceAhead_) device_->downloadRows(particles_, row, end);
+    hostRowsAhead_.emplace_back(row, end);
+    row = end;
+  }
+}
+
+template <class S>
+void World<S>::flushRowsToDevice() {
+  for (const auto& [begin, end] : hostRowsAhead_) device_->uploadRows(particles_, begin, end);
+  hostRowsAhead_.clear();
+}
+
+template <class S>
 void World<S>::syncFromDevice() const {
   if (!deviceAhead_) return;
   // Worlds are never const objects (makeWorld builds them on the heap): const here means "the
   // state does not change", which holds; only where it is held does.
   auto* self = const_cast<World<S>*>(this);
+  self->flushRowsToDevice();  // rows the host pushed after the device's pass (a fault stopped the tick)
   self->device_->download(self->particles_, &self->dispX_, &self->dispY_, &self->dispZ_);
   self->deviceAhead_ = false;
   self->updatePatchesFromDisplacement();  // the patch stage the device path left to here
@@ -117,7 +145,9 @@ void World<S>::syncFromDevice() const {
   template std::string World<S>::deviceLimitation() const;                             \
   template std::string World<S>::setPhysicsPath(PhysicsPath, ParticleDeviceProvider*); \
   template bool World<S>::deviceParticlePass();                                        \
-  template void World<S>::syncFromDevice() const;
+  template void World<S>::syncFromDevice() const;                                      \
+  template void World<S>::bringPushedRowsToHost(const GrassPushers<S>&);               \
+  template void World<S>::flushRowsToDevice();
 
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE_DEVICE)
 

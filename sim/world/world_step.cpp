@@ -138,42 +138,43 @@ bool World<S>::integrateStage() {
     return pbd ? advanceParticleRow<S, true>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_)
                : advanceParticleRow<S, false>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_);
   };
-  // On a device (world_device.cpp; no bodies on that path), unless the pass faulted: then the
-  // reference below redoes the tick and reports the fault.
-  if (device_ && deviceParticlePass()) return true;
+  // On a device (world_device.cpp), unless the pass faulted: then the reference below redoes the
+  // tick and reports the fault.
+  const bool onDevice = device_ && deviceParticlePass();
   const bool rowUniform = windSchedule_.rowUniform();
   const LatticeWindow& window = grid_.window;
-  const bool moved = runParticleRows(Stage::Integrate, [&](int64_t row, int64_t b, int64_t e) -> RowFault {
-    const int64_t latticeRow = window.latticeRow(row);
-    if (rowUniform) {  // the wind acts per lattice row
-      const size_t r = size_t(latticeRow);
-      return advance(b, e, rowAccel_.x[r], rowAccel_.y[r], rowAccel_.z[r]);
-    }
-    // Gust fronts crossing the rows: runs of columns under the same wind (sim/wind/wind.h), each
-    // advanced as a row would be, in storage order (a window wraps its columns at most once).
-    thread_local std::vector<WindRun<S>> runs;
-    thread_local std::vector<std::pair<int64_t, size_t>> pieces;  // storage start, run
-    computeRowWind(windSchedule_, windConsts_, tick_, latticeRow, window.originI, window.endI(), &runs);
-    pieces.clear();
-    for (size_t k = 0; k < runs.size(); ++k) {
-      const int64_t start = window.storageColumn(runs[k].begin), length = runs[k].end - runs[k].begin;
-      pieces.push_back({start, k});
-      if (start + length > grid_.countX) pieces.push_back({0, k});  // the part past the wrap
-    }
-    std::sort(pieces.begin(), pieces.end());
-    for (const auto& [start, k] : pieces) {
-      const WindRun<S>& run = runs[k];
-      const int64_t first = window.storageColumn(run.begin), length = run.end - run.begin;
-      // This piece's storage columns: [first, min(first + length, countX)) or, past the wrap,
-      // [0, first + length - countX).
-      const int64_t c0 = start == first ? first : 0;
-      const int64_t c1 = start == first ? std::min(first + length, grid_.countX) : first + length - grid_.countX;
-      const RowFault fault = advance(b + c0, b + c1, run.dvx, run.dvy, run.dvz);
-      if (fault.particle >= 0) return fault;
-    }
-    (void)e;
-    return {};
-  });
+  const bool moved =
+      onDevice || runParticleRows(Stage::Integrate, [&](int64_t row, int64_t b, int64_t e) -> RowFault {
+        const int64_t latticeRow = window.latticeRow(row);
+        if (rowUniform) {  // the wind acts per lattice row
+          const size_t r = size_t(latticeRow);
+          return advance(b, e, rowAccel_.x[r], rowAccel_.y[r], rowAccel_.z[r]);
+        }
+        // Gust fronts crossing the rows: runs of columns under the same wind (sim/wind/wind.h), each
+        // advanced as a row would be, in storage order (a window wraps its columns at most once).
+        thread_local std::vector<WindRun<S>> runs;
+        thread_local std::vector<std::pair<int64_t, size_t>> pieces;  // storage start, run
+        computeRowWind(windSchedule_, windConsts_, tick_, latticeRow, window.originI, window.endI(), &runs);
+        pieces.clear();
+        for (size_t k = 0; k < runs.size(); ++k) {
+          const int64_t start = window.storageColumn(runs[k].begin), length = runs[k].end - runs[k].begin;
+          pieces.push_back({start, k});
+          if (start + length > grid_.countX) pieces.push_back({0, k});  // the part past the wrap
+        }
+        std::sort(pieces.begin(), pieces.end());
+        for (const auto& [start, k] : pieces) {
+          const WindRun<S>& run = runs[k];
+          const int64_t first = window.storageColumn(run.begin), length = run.end - run.begin;
+          // This piece's storage columns: [first, min(first + length, countX)) or, past the wrap,
+          // [0, first + length - countX).
+          const int64_t c0 = start == first ? first : 0;
+          const int64_t c1 = start == first ? std::min(first + length, grid_.countX) : first + length - grid_.countX;
+          const RowFault fault = advance(b + c0, b + c1, run.dvx, run.dvy, run.dvz);
+          if (fault.particle >= 0) return fault;
+        }
+        (void)e;
+        return {};
+      });
   if (!moved || bodies_.empty()) return moved;
   // The bodies moved in the response stage (the soft step integrates their positions in every
   // sub-step); here they may fall asleep, by islands.
