@@ -62,6 +62,10 @@ void World<S>::fillWindow(int64_t originI, int64_t originJ, bool initialVelocity
 
 template <class S>
 void World<S>::moveWindowTo(int64_t originI, int64_t originJ, bool initialVelocity, bool everything) {
+  // On a device (world_device.cpp) the particles come back whole before the window writes its
+  // entering cells, and go up whole (anchors included) before the next pass.
+  syncFromDevice();
+  if (device_) hostAhead_ = true;
   const LatticeWindow oldParticles = grid_.window, oldPatches = patchWindow_;
   grid_.window.originI = originI;
   grid_.window.originJ = originJ;

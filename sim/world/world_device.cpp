@@ -1,5 +1,7 @@
 // World<S> on a device (docs/gpu-physics.md): which worlds may move their grass stages off the
 // CPU, the particle pass there, and copying the particles back where the host reads them.
+#include <algorithm>
+
 #include "sim/world/world.h"
 
 namespace sg {
@@ -9,7 +11,6 @@ std::string World<S>::deviceLimitation() const {
   if constexpr (!ScalarTraits<S>::isFixed) {
     return std::string("the device path runs fx32 and fx16 (this world is ") + scalarName(ScalarTraits<S>::kind) + ")";
   } else {
-    if (lodWindow_) return "the device path has no level-of-detail window yet (lod.mode 'window')";
     return "";
   }
 }
@@ -61,20 +62,36 @@ bool World<S>::deviceParticlePass() {
   wind.dvy.clear();
   wind.dvz.clear();
   const bool rowUniform = windSchedule_.rowUniform();
+  const LatticeWindow& window = grid_.window;
   thread_local std::vector<WindRun<S>> runs;
+  thread_local std::vector<std::pair<int64_t, size_t>> pieces;  // storage start, run
   for (int64_t r = 0; r < grid_.countZ; ++r) {
     wind.rowFirstRun.push_back(int32_t(wind.runBegin.size()));
-    if (rowUniform) {
-      runs.assign(1,
-                  WindRun<S>{0, grid_.countX, rowAccel_.x[size_t(r)], rowAccel_.y[size_t(r)], rowAccel_.z[size_t(r)]});
-    } else {
-      computeRowWind(windSchedule_, windConsts_, tick_, r, 0, grid_.countX, &runs);
-    }
-    for (const WindRun<S>& run : runs) {
-      wind.runBegin.push_back(int32_t(run.begin));
+    const int64_t latticeRow = window.latticeRow(r);
+    const auto addRun = [&](int64_t begin, const WindRun<S>& run) {
+      wind.runBegin.push_back(int32_t(begin));
       wind.dvx.push_back(run.dvx);
       wind.dvy.push_back(run.dvy);
       wind.dvz.push_back(run.dvz);
+    };
+    if (rowUniform) {
+      const size_t l = size_t(latticeRow);
+      addRun(0, WindRun<S>{0, grid_.countX, rowAccel_.x[l], rowAccel_.y[l], rowAccel_.z[l]});
+      continue;
+    }
+    // As the CPU pass cuts a row (world_step.cpp): the runs in lattice columns, then in storage
+    // order, a run that wraps round the window's toroidal storage split in two.
+    computeRowWind(windSchedule_, windConsts_, tick_, latticeRow, window.originI, window.endI(), &runs);
+    pieces.clear();
+    for (size_t k = 0; k < runs.size(); ++k) {
+      const int64_t start = window.storageColumn(runs[k].begin), length = runs[k].end - runs[k].begin;
+      pieces.push_back({start, k});
+      if (start + length > grid_.countX) pieces.push_back({0, k});
+    }
+    std::sort(pieces.begin(), pieces.end());
+    for (const auto& [start, k] : pieces) {
+      const int64_t first = window.storageColumn(runs[k].begin);
+      addRun(start == first ? first : 0, runs[k]);
     }
   }
   wind.rowFirstRun.push_back(int32_t(wind.runBegin.size()));
