@@ -164,7 +164,10 @@ std::string VariantSettings::describe() const {
 
 bool VariantSettings::mustBeIdenticalTo(const VariantSettings& reference) const {
   const VariantSettings mine = over(reference);
-  return mine.scalar == reference.scalar && mine.interpolation == reference.interpolation &&
+  // On a device only the fixed-point formats keep the CPU's bits (docs/gpu-physics.md).
+  const bool deviceFloat = mine.physics.value_or(PhysicsPath::Cpu) != PhysicsPath::Cpu &&
+                           (mine.scalar == ScalarKind::Float || mine.scalar == ScalarKind::Double);
+  return !deviceFloat && mine.scalar == reference.scalar && mine.interpolation == reference.interpolation &&
          mine.timeStep == reference.timeStep &&
          mine.lod.value_or(LodMode::Off) == reference.lod.value_or(LodMode::Off) &&
          mine.model.value_or(GrassModel::Thesis) == reference.model.value_or(GrassModel::Thesis);

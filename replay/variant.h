@@ -25,8 +25,9 @@ struct VariantSettings {
   /// particles' acceleration, initial velocity and damping (the thesis' 1 m/s^2 lift is not a blade's
   /// gravity); everything else stays.
   std::optional<GrassModel> model;
-  /// Where the grass stages run (cpu, gpu, gpu-readback): not part of the state, so it must be
-  /// bit-identical, like threads (docs/gpu-physics.md).
+  /// Where the grass stages run (cpu, gpu, gpu-readback): not part of the state, so for fx32 and
+  /// fx16 it must be bit-identical, like threads; float on the device is a comparison variant
+  /// without that promise (docs/gpu-physics.md).
   std::optional<PhysicsPath> physics;
 
   /// Parses "interp=2", "scalar=fx16,dt=1/120", ...; later keys override earlier ones.
@@ -41,8 +42,8 @@ struct VariantSettings {
   static VariantSettings resolvedFrom(const Scenario& scenario);
   /// "scalar=fx32 interp=1 broadphase=grid body-broadphase=brute dt=1/60" (set keys only).
   std::string describe() const;
-  /// True when the variant cannot change the state (only broad phases and threads differ from
-  /// `reference`): the run must be bit-identical to it.
+  /// True when the variant cannot change the state (only broad phases, threads and, for fx32 and
+  /// fx16, the physics path differ from `reference`): the run must be bit-identical to it.
   bool mustBeIdenticalTo(const VariantSettings& reference) const;
 };
 

@@ -304,7 +304,7 @@ void addCompareCommand(CLI::App& app, int* exitCode) {
   cmd->add_option("recording", o->file, "Recording (.sgr): its own settings are the reference")->required();
   cmd->add_option("--variant", o->variants,
                   "One variant row: scalar=fx16, interp=2, broadphase=brute, body-broadphase=sap, dt=1/120, lod=off, "
-                  "model=blade (or thesis, pbd), threads=2; "
+                  "model=blade (or thesis, pbd), threads=2, physics=gpu (or gpu-readback, cpu); "
                   "combine with commas (scalar=fx16,interp=2). Repeatable")
       ->required()
       ->allow_extra_args(false);  // one value per --variant: `--variant interp=2 run.sgr` keeps run.sgr

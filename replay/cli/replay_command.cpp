@@ -91,7 +91,14 @@ int replay(const ReplayOptions& o) {
     printError("simgrass replay: %s\n", e.what());
     return kExitBadInput;
   } catch (const std::invalid_argument& e) {
-    printError("simgrass replay: %s: --%s\n", o.file.c_str(), e.what());
+    printError("simgrass replay: %s: %s\n", o.file.c_str(), e.what());
+    return kExitBadInput;
+  }
+  if (onPath.physics.value_or(PhysicsPath::Cpu) != PhysicsPath::Cpu && player->world().scalar() == ScalarKind::Float) {
+    printError(
+        "simgrass replay: %s: physics=%s: float on the device is a comparison variant without the CPU's "
+        "bits, so the recorded hashes do not apply: use compare --variant physics=%s\n",
+        o.file.c_str(), o.physics.c_str(), o.physics.c_str());
     return kExitBadInput;
   }
   const int64_t last = rec->lastTick();

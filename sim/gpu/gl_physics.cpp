@@ -72,13 +72,26 @@ enum Binding : GLuint {
   kTrampleOut
 };
 
+/// What a value of S is stored as in the buffers: a fixed-point value is its raw integer, a float
+/// itself.
+template <class S>
+struct Stored {
+  using Type = typename S::RawType;
+  static Type of(S v) { return v.raw(); }
+};
+template <>
+struct Stored<float> {
+  using Type = float;
+  static float of(float v) { return v; }
+};
+
 /// One world's particles in shader storage buffers, and the pass over them. Positions,
 /// velocities and trample levels are double-buffered: a pass reads set `current_` and writes the
 /// other, which becomes current only when the pass did not fault.
 template <class S>
 class GlParticleDevice final : public ParticleDevice<S> {
-  using Raw = typename S::RawType;
-  static_assert(sizeof(S) == sizeof(Raw) && std::is_trivially_copyable_v<S>, "Fixed is its raw value");
+  using Raw = typename Stored<S>::Type;
+  static_assert(sizeof(S) == sizeof(Raw) && std::is_trivially_copyable_v<S>, "a value is stored as itself");
 
  public:
   GlParticleDevice(std::shared_ptr<ComputeContext> context, GLuint program, int64_t countX, int64_t countZ,
@@ -113,12 +126,14 @@ class GlParticleDevice final : public ParticleDevice<S> {
   RowFault advance(const DeviceWind<S>& wind, const ParticleConstants<S>& c, uint32_t* faultBits) override {
     context_->makeCurrent();
     const size_t runCount = wind.runBegin.size();
-    tick_.assign({c.dt.raw(), c.dampingPerTick.raw(), c.rodLength.raw(), c.invDt.raw(), c.bladeStiffnessDt.raw(),
-                  c.bladeDampingPerTick.raw(), c.trampleDecayPerTick.raw(), c.invRodLength.raw()});
+    using St = Stored<S>;
+    tick_.assign({St::of(c.dt), St::of(c.dampingPerTick), St::of(c.rodLength), St::of(c.invDt),
+                  St::of(c.bladeStiffnessDt), St::of(c.bladeDampingPerTick), St::of(c.trampleDecayPerTick),
+                  St::of(c.invRodLength)});
     for (size_t k = 0; k < runCount; ++k) {
-      tick_.push_back(wind.dvx[k].raw());
-      tick_.push_back(wind.dvy[k].raw());
-      tick_.push_back(wind.dvz[k].raw());
+      tick_.push_back(St::of(wind.dvx[k]));
+      tick_.push_back(St::of(wind.dvy[k]));
+      tick_.push_back(St::of(wind.dvz[k]));
     }
     runs_.assign(wind.rowFirstRun.begin(), wind.rowFirstRun.end());
     for (int64_t r = 0; r < countZ_; ++r) {  // each run as [begin, end)
@@ -161,7 +176,9 @@ class GlParticleDevice final : public ParticleDevice<S> {
       current_ = next;
       return {};
     }
-    *faultBits = kFixedFaultOverflow;  // the only fault the pass can raise (no d = 0 division, no negative root)
+    // The only fixed-point fault the pass can raise (no d = 0 division, no negative root); a float
+    // pass faults on a non-finite value, which has no fault bits.
+    *faultBits = std::is_same_v<S, float> ? 0u : uint32_t(kFixedFaultOverflow);
     return decode(key, wind);
   }
 
@@ -279,6 +296,10 @@ class OsmesaPhysicsProvider final : public ParticleDeviceProvider {
                                                  std::string* error) override {
     return make<Fx16>(countX, countZ, model, tramples, error);
   }
+  std::unique_ptr<ParticleDevice<float>> makeFloat(int64_t countX, int64_t countZ, GrassModel model, bool tramples,
+                                                   std::string* error) override {
+    return make<float>(countX, countZ, model, tramples, error);
+  }
   std::string describe() const override { return context_->description; }
 
  private:
@@ -298,11 +319,13 @@ class OsmesaPhysicsProvider final : public ParticleDeviceProvider {
     // One program per format, model and trampling, compiled on first use and kept.
     const int modelIndex = model == GrassModel::Pbd ? 1 : model == GrassModel::Blade ? 2 : 0;
     tramples = tramples && model == GrassModel::Blade;
-    GLuint& program = programs_[std::is_same_v<S, Fx32> ? 0 : 1][modelIndex][tramples ? 1 : 0];
+    const int format = std::is_same_v<S, Fx32> ? 0 : std::is_same_v<S, Fx16> ? 1 : 2;
+    GLuint& program = programs_[format][modelIndex][tramples ? 1 : 0];
     if (!program) {
       const std::string prelude = std::string("#version 450\n#extension GL_ARB_gpu_shader_int64 : require\n") +
-                                  "#define FX32 " + (std::is_same_v<S, Fx32> ? "1" : "0") + "\n#define MODEL " +
-                                  std::to_string(modelIndex) + "\n#define TRAMPLE " + (tramples ? "1" : "0") + "\n";
+                                  "#define FX32 " + (format == 0 ? "1" : "0") + "\n#define FLOAT " +
+                                  (format == 2 ? "1" : "0") + "\n#define MODEL " + std::to_string(modelIndex) +
+                                  "\n#define TRAMPLE " + (tramples ? "1" : "0") + "\n";
       program = buildProgram(prelude + kParticlePassGlsl, error);
       if (!program) return nullptr;
     }
@@ -317,7 +340,7 @@ class OsmesaPhysicsProvider final : public ParticleDeviceProvider {
   }
 
   std::shared_ptr<ComputeContext> context_;
-  GLuint programs_[2][3][2] = {};  ///< [fx32, fx16][thesis, pbd, blade][trample]
+  GLuint programs_[3][3][2] = {};  ///< [fx32, fx16, float][thesis, pbd, blade][trample]
 };
 
 }  // namespace

@@ -5,7 +5,8 @@
 // Q32.32's 128-bit product built from 32 x 32 -> 64 partial products; L / |d| and |d| are guessed
 // in double precision and then settled in exact integer arithmetic (the guess only decides how
 // many correction steps run, never the result). The prelude gl_physics.cpp puts before this text
-// defines FX32 (1: Q32.32, 0: Q16.16), MODEL (0 thesis, 1 pbd, 2 blade) and TRAMPLE (0 or 1).
+// defines FLOAT (1: float, the comparison variant), FX32 (1: Q32.32; both 0: Q16.16), MODEL
+// (0 thesis, 1 pbd, 2 blade) and TRAMPLE (0 or 1).
 #pragma once
 
 namespace sg::gpu {
@@ -13,12 +14,15 @@ namespace sg::gpu {
 inline constexpr const char* kParticlePassGlsl = R"GLSL(
 layout(local_size_x = 256) in;
 
-#if FX32
+#if FLOAT
+#define RAW float
+#define ONE 1.0
+#elif FX32
 #define RAW int64_t
-#define FRAC 32
+#define ONE (int64_t(1) << 32)
 #else
 #define RAW int
-#define FRAC 16
+#define ONE (1 << 16)
 #endif
 
 // Each buffer holds three arrays of `count` values (x, then y, then z). The pass reads one set of
@@ -112,7 +116,28 @@ uint64_t isqrtFloor128(uint64_t nh, uint64_t nl) {
   return r;  // unreachable: each step at least halves the error once the guess is close
 }
 
-#if FX32
+#if FLOAT
+// ---- float: a comparison variant, no bit-identity promise (GLSL allows division and sqrt some
+// latitude). `precise` keeps each product out of a fused multiply-add, as -ffp-contract=off does
+// on the CPU; a fault is a non-finite result, as the CPU's float kernels report it.
+RAW addChecked(RAW a, RAW b) { precise RAW r = a + b; return r; }
+RAW subChecked(RAW a, RAW b) { precise RAW r = a - b; return r; }
+RAW mulChecked(RAW a, RAW b) { precise RAW r = a * b; return r; }
+RAW divChecked(RAW a, RAW b) { precise RAW r = a / b; return r; }
+RAW length3(RAW x, RAW y, RAW z) {
+  precise RAW xx = x * x;
+  precise RAW yy = y * y;
+  precise RAW zz = z * z;
+  precise RAW sum = xx + yy;
+  precise RAW total = sum + zz;
+  return sqrt(total);
+}
+void checkFinite(RAW a, RAW b, RAW c, RAW d, RAW e, RAW f) {
+  if (isinf(a) || isnan(a) || isinf(b) || isnan(b) || isinf(c) || isnan(c) || isinf(d) || isnan(d) || isinf(e) ||
+      isnan(e) || isinf(f) || isnan(f))
+    overflowed = true;
+}
+#elif FX32
 // ---- Q32.32 (fixed.h's Fx32: int64 raw, 128-bit wide) ---------------------------------------
 RAW addChecked(RAW a, RAW b) { RAW r = a + b; if (((a ^ r) & (b ^ r)) < 0l) overflowed = true; return r; }
 RAW subChecked(RAW a, RAW b) { RAW r = a - b; if (((a ^ b) & (a ^ r)) < 0l) overflowed = true; return r; }
@@ -191,6 +216,10 @@ RAW length3(RAW x, RAW y, RAW z) {
 }
 #endif
 
+#if !FLOAT
+void checkFinite(RAW a, RAW b, RAW c, RAW d, RAW e, RAW f) {}  // every fixed-point value is finite
+#endif
+
 void noteFault(uint key) { atomicMin(faultKey, key); }
 
 void main() {
@@ -223,7 +252,7 @@ void main() {
   RAW stiffness = tickData[4], damping = tickData[5], decay = tickData[6], invRod = tickData[7];
 #if TRAMPLE
   RAW trample = trampleIn[i];
-  stiffness = mulChecked(stiffness, subChecked(RAW(1) << FRAC, trample));
+  stiffness = mulChecked(stiffness, subChecked(RAW(ONE), trample));
   trampleOut[i] = trample > decay ? subChecked(trample, decay) : RAW(0);
 #endif
   RAW rx = subChecked(x, ax), ry = subChecked(y, ay), rz = subChecked(z, az);
@@ -255,6 +284,7 @@ void main() {
   u = addChecked(u, mulChecked(subChecked(nx, predictedX), invDt));
   v = addChecked(v, mulChecked(subChecked(ny, predictedY), invDt));
   w = addChecked(w, mulChecked(subChecked(nz, predictedZ), invDt));
+  checkFinite(nx, ny, nz, u, v, w);
   if (overflowed) noteFault(integrationKey);
 #else
   RAW damping = tickData[1];
@@ -272,6 +302,7 @@ void main() {
   y = addChecked(y, mulChecked(v, dt));
   z = addChecked(z, mulChecked(w, dt));
 #endif
+  checkFinite(x, y, z, u, v, w);
   if (overflowed) noteFault(integrationKey);
 
   // Stage 4, rod_constraint.h.
@@ -293,6 +324,7 @@ void main() {
   v = addChecked(v, mulChecked(subChecked(ny, y), invDt));
   w = addChecked(w, mulChecked(subChecked(nz, z), invDt));
 #endif
+  checkFinite(nx, ny, nz, u, v, w);
   if (overflowed) noteFault(projectionKey);
 #endif
 

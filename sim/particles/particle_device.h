@@ -61,6 +61,10 @@ class ParticleDeviceProvider {
                                                          bool tramples, std::string* error) = 0;
   virtual std::unique_ptr<ParticleDevice<Fx16>> makeFx16(int64_t countX, int64_t countZ, GrassModel model,
                                                          bool tramples, std::string* error) = 0;
+  /// float, as a comparison variant: the device's float operations, with no promise of the CPU's
+  /// bits (GLSL leaves division and square roots a little latitude).
+  virtual std::unique_ptr<ParticleDevice<float>> makeFloat(int64_t countX, int64_t countZ, GrassModel model,
+                                                           bool tramples, std::string* error) = 0;
   /// The device in words ("OpenGL 4.5 compute on llvmpipe (LLVM 15.0.6, 256 bits)").
   virtual std::string describe() const = 0;
 };

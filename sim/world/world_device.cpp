@@ -8,11 +8,12 @@ namespace sg {
 
 template <class S>
 std::string World<S>::deviceLimitation() const {
-  if constexpr (!ScalarTraits<S>::isFixed) {
-    return std::string("the device path runs fx32 and fx16 (this world is ") + scalarName(ScalarTraits<S>::kind) + ")";
-  } else {
+  // fx32 and fx16 with the CPU's bits; float as a comparison variant without that promise.
+  if constexpr (std::is_same_v<S, double>)
+    return "the device path runs fx32 and fx16 (the CPU's bits) and float (a comparison variant); this world is "
+           "double";
+  else
     return "";
-  }
 }
 
 template <class S>
@@ -26,14 +27,16 @@ std::string World<S>::setPhysicsPath(PhysicsPath path, ParticleDeviceProvider* p
   }
   if (const std::string why = deviceLimitation(); !why.empty()) return why;
   if (!provider) return "no device: this build has no GPU physics";
-  if constexpr (ScalarTraits<S>::isFixed) {
+  if constexpr (!std::is_same_v<S, double>) {
     std::string error;
     std::unique_ptr<ParticleDevice<S>> device;
     const bool tramples = !particles_.trample.empty();
     if constexpr (std::is_same_v<S, Fx32>)
       device = provider->makeFx32(grid_.countX, grid_.countZ, model_, tramples, &error);
-    else
+    else if constexpr (std::is_same_v<S, Fx16>)
       device = provider->makeFx16(grid_.countX, grid_.countZ, model_, tramples, &error);
+    else
+      device = provider->makeFloat(grid_.countX, grid_.countZ, model_, tramples, &error);
     if (!device) return error.empty() ? "the device could not be set up" : error;
     syncFromDevice();  // from an old device, if any: the host is the truth again
     device_ = std::move(device);
