@@ -25,7 +25,7 @@ std::string World<S>::setPhysicsPath(PhysicsPath path, ParticleDeviceProvider* p
     physicsPath_ = path;
     return "";
   }
-  if (const std::string why = deviceLimitation(); !why.empty()) return why;
+  if (std::string why = deviceLimitation(); !why.empty()) return why;
   if (!provider) return "no device: this build has no GPU physics";
   if constexpr (!std::is_same_v<S, double>) {
     std::string error;
