@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "sim/world/world.h"
+#include "sim/world/world_rows.h"
 
 namespace sg {
 
@@ -67,7 +68,7 @@ bool World<S>::deviceParticlePass() {
   const bool rowUniform = windSchedule_.rowUniform();
   const LatticeWindow& window = grid_.window;
   thread_local std::vector<WindRun<S>> runs;
-  thread_local std::vector<std::pair<int64_t, size_t>> pieces;  // storage start, run
+  thread_local std::vector<WindPiece> pieces;
   for (int64_t r = 0; r < grid_.countZ; ++r) {
     wind.rowFirstRun.push_back(int32_t(wind.runBegin.size()));
     const int64_t latticeRow = window.latticeRow(r);
@@ -82,20 +83,10 @@ bool World<S>::deviceParticlePass() {
       addRun(0, WindRun<S>{0, grid_.countX, rowAccel_.x[l], rowAccel_.y[l], rowAccel_.z[l]});
       continue;
     }
-    // As the CPU pass cuts a row (world_step.cpp): the runs in lattice columns, then in storage
-    // order, a run that wraps round the window's toroidal storage split in two.
+    // As the CPU pass cuts a row (world_rows.h): its pieces in storage order.
     computeRowWind(windSchedule_, windConsts_, tick_, latticeRow, window.originI, window.endI(), &runs);
-    pieces.clear();
-    for (size_t k = 0; k < runs.size(); ++k) {
-      const int64_t start = window.storageColumn(runs[k].begin), length = runs[k].end - runs[k].begin;
-      pieces.push_back({start, k});
-      if (start + length > grid_.countX) pieces.push_back({0, k});
-    }
-    std::sort(pieces.begin(), pieces.end());
-    for (const auto& [start, k] : pieces) {
-      const int64_t first = window.storageColumn(runs[k].begin);
-      addRun(start == first ? first : 0, runs[k]);
-    }
+    windPiecesInStorageOrder(window, grid_.countX, runs, &pieces);
+    for (const WindPiece& piece : pieces) addRun(piece.begin, runs[piece.run]);
   }
   wind.rowFirstRun.push_back(int32_t(wind.runBegin.size()));
   // A fault anywhere in the pass (or in the wind above, which the CPU pass meets inside its rows)

@@ -3,9 +3,36 @@
 // into the world's failure. Included by the files whose stages loop over particle rows.
 #pragma once
 
+#include <algorithm>
+#include <vector>
+
 #include "sim/world/world.h"
 
 namespace sg {
+
+/// Storage columns [begin, end) of one particle row under wind run `run`.
+struct WindPiece {
+  int64_t begin = 0, end = 0;
+  size_t run = 0;
+};
+
+/// One row's wind runs (lattice columns, computeRowWind) as pieces in storage order: a run that
+/// wraps round the window's toroidal storage is split in two (a window wraps its columns at most
+/// once). The CPU pass advances the pieces in this order and the device path uploads them in it,
+/// so both meet a row's faults in the same order. Replaces *out.
+template <class S>
+void windPiecesInStorageOrder(const LatticeWindow& window, int64_t countX, const std::vector<WindRun<S>>& runs,
+                              std::vector<WindPiece>* out) {
+  out->clear();
+  for (size_t k = 0; k < runs.size(); ++k) {
+    const int64_t first = window.storageColumn(runs[k].begin), length = runs[k].end - runs[k].begin;
+    out->push_back({first, std::min(first + length, countX), k});
+    if (first + length > countX) out->push_back({0, first + length - countX, k});  // the part past the wrap
+  }
+  std::sort(out->begin(), out->end(), [](const WindPiece& a, const WindPiece& b) {
+    return a.begin != b.begin ? a.begin < b.begin : a.run < b.run;
+  });
+}
 
 template <class S>
 template <class Fn>

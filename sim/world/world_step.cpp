@@ -153,23 +153,12 @@ bool World<S>::integrateStage() {
         // Gust fronts crossing the rows: runs of columns under the same wind (sim/wind/wind.h), each
         // advanced as a row would be, in storage order (a window wraps its columns at most once).
         thread_local std::vector<WindRun<S>> runs;
-        thread_local std::vector<std::pair<int64_t, size_t>> pieces;  // storage start, run
+        thread_local std::vector<WindPiece> pieces;
         computeRowWind(windSchedule_, windConsts_, tick_, latticeRow, window.originI, window.endI(), &runs);
-        pieces.clear();
-        for (size_t k = 0; k < runs.size(); ++k) {
-          const int64_t start = window.storageColumn(runs[k].begin), length = runs[k].end - runs[k].begin;
-          pieces.push_back({start, k});
-          if (start + length > grid_.countX) pieces.push_back({0, k});  // the part past the wrap
-        }
-        std::sort(pieces.begin(), pieces.end());
-        for (const auto& [start, k] : pieces) {
-          const WindRun<S>& run = runs[k];
-          const int64_t first = window.storageColumn(run.begin), length = run.end - run.begin;
-          // This piece's storage columns: [first, min(first + length, countX)) or, past the wrap,
-          // [0, first + length - countX).
-          const int64_t c0 = start == first ? first : 0;
-          const int64_t c1 = start == first ? std::min(first + length, grid_.countX) : first + length - grid_.countX;
-          const RowFault fault = advance(b + c0, b + c1, run.dvx, run.dvy, run.dvz);
+        windPiecesInStorageOrder(window, grid_.countX, runs, &pieces);
+        for (const WindPiece& piece : pieces) {
+          const WindRun<S>& run = runs[piece.run];
+          const RowFault fault = advance(b + piece.begin, b + piece.end, run.dvx, run.dvy, run.dvz);
           if (fault.particle >= 0) return fault;
         }
         (void)e;
