@@ -11,7 +11,10 @@ std::string gProviderError;
 bool gTried = false;
 }  // namespace
 
-void registerGpuPhysics(GpuPhysicsFactory factory) { gFactory = factory; }
+void registerGpuPhysics(GpuPhysicsFactory factory) {
+  gFactory = factory;
+  if (!gProvider) gTried = false;  // a failure of the previous factory is not this one's
+}
 
 ParticleDeviceProvider* gpuPhysicsProvider(std::string* error) {
   if (!gFactory) {

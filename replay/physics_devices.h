@@ -15,7 +15,8 @@ namespace sg {
 
 /// Makes the process's GPU device provider, or nullptr with *error set.
 using GpuPhysicsFactory = std::unique_ptr<ParticleDeviceProvider> (*)(std::string* error);
-/// Registers the factory (once, before any world asks for the GPU path).
+/// Registers the factory. A provider already made stays the process's; until one is made, the
+/// last factory registered makes it (the viewer registers its window's context once GL is up).
 void registerGpuPhysics(GpuPhysicsFactory factory);
 /// The process's provider, made on first use; nullptr with *error set when the build has no GPU
 /// path or no context can be made.

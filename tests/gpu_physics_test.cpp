@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "replay/physics_devices.h"
@@ -18,9 +19,14 @@
 #include "sim/gpu/gl_physics.h"
 #include "sim/particles/blade.h"
 #include "sim/particles/particle_row.h"
+#include "tests/cli_support.h"
 #include "tests/test_support.h"
 
 namespace sg {
+namespace viewer_test {
+CliResult runViewer(const std::string& args, bool xvfb = true, const std::string& cwd = "");  // tests/viewer_test.cpp
+}  // namespace viewer_test
+
 namespace {
 
 /// One provider for the whole test program, never destroyed (as replay/physics_devices.cpp keeps
@@ -56,6 +62,29 @@ std::unique_ptr<SimWorld> onPath(const Scenario& s, PhysicsPath path, int thread
   return w;
 }
 
+/// The device's own patch stage (derivePatches, what a renderer in its context draws) against
+/// the host's, which derives its copy from the device's displacement when the state is copied
+/// back: every tip offset, top and tilt level, bit for bit.
+template <class S>
+::testing::AssertionResult devicePatchesAreTheHosts(const World<S>& w) {
+  PatchArrays<S> device;
+  if (!w.downloadDevicePatches(&device)) return ::testing::AssertionFailure() << "no device patches";
+  const PatchArrays<S>& host = w.patches();  // copies the state back, derives the host's
+  const size_t n = host.topY.size();
+  for (size_t p = 0; p < n; ++p)
+    if (!(device.tipOffsetX[p] == host.tipOffsetX[p]) || !(device.tipOffsetZ[p] == host.tipOffsetZ[p]) ||
+        !(device.topY[p] == host.topY[p]) || device.tiltLevel[p] != host.tiltLevel[p])
+      return ::testing::AssertionFailure()
+             << "patch slot " << p << " of " << n << ": top " << ScalarTraits<S>::toDouble(device.topY[p])
+             << " on the device, " << ScalarTraits<S>::toDouble(host.topY[p]) << " on the host";
+  return ::testing::AssertionSuccess() << n << " patches";
+}
+::testing::AssertionResult devicePatchesAreTheHosts(const SimWorld& w) {
+  if (const auto* a = dynamic_cast<const World<Fx32>*>(&w)) return devicePatchesAreTheHosts(*a);
+  if (const auto* b = dynamic_cast<const World<Fx16>*>(&w)) return devicePatchesAreTheHosts(*b);
+  return ::testing::AssertionFailure() << "not a fixed-point world";
+}
+
 // ---- goldens ---------------------------------------------------------------------------------
 
 struct GoldenRun {
@@ -81,6 +110,9 @@ TEST_P(GpuGolden, EveryComparedTickEqualsTheCpuAndTheGolden) {
     ASSERT_TRUE(gpu->step(scriptedInput(s, gpu->tick())).ok) << "tick " << t;
     const bool compare = r.path == PhysicsPath::GpuReadback || t <= 3 || t % 97 == 0 || t == 600;
     if (compare) {
+      if (r.path == PhysicsPath::Gpu) {
+        ASSERT_TRUE(devicePatchesAreTheHosts(*gpu)) << "tick " << t;
+      }
       ASSERT_EQ(hex(gpu->stateHash()), hex(cpu->stateHash())) << "tick " << t;
     }
   }
@@ -142,6 +174,150 @@ TEST(GpuPhysics, AMovingWindowUnderGustFrontsMatchesTheCpu) {
     }
     EXPECT_NE(cpu->counts().windowOriginI, 0) << "the window was meant to move";
   }
+}
+
+/// The device's patch stage at every interpolation k (k = 3's weights are not powers of two),
+/// under a level-of-detail window drifting across the field, whose patch and particle storage
+/// wrap independently.
+TEST(GpuPhysics, DevicePatchStageIsTheHostsAtEveryInterpolation) {
+  for (const char* scalar : {"fx32", "fx16"})
+    for (int k : {1, 2, 3, 4}) {
+      Scenario s = scenarioNamed("wind-fronts", scalar);
+      s.particles.interpolation = k;
+      s.lod.mode = LodMode::Window;
+      s.lod.windowX = s.lod.windowZ = 23;
+      s.lod.edgeRows = 4;
+      auto gpu = onPath(s, PhysicsPath::Gpu);
+      TickInput in;
+      in.hasCamera = true;
+      for (int64_t t = 1; t <= 120; ++t) {
+        const int64_t metresX256 = -3600 + 30 * t, metresZ256 = -3600 + 21 * t;
+        in.camera = {metresX256 << 24, 0, metresZ256 << 24};
+        ASSERT_TRUE(gpu->step(in).ok);
+        if (t % 40 == 0) {
+          ASSERT_TRUE(devicePatchesAreTheHosts(*gpu)) << scalar << " k " << k << " tick " << t;
+        }
+      }
+      EXPECT_NE(gpu->counts().windowOriginI, 0) << "the window was meant to move";
+    }
+}
+
+/// The resident path's promise: between ticks nothing comes back but the 4-byte fault word,
+/// until the host reads the state (a hash here), which copies the particles and displacement.
+TEST(GpuPhysics, TheResidentPathCopiesBackOnlyTheFaultWord) {
+  const Scenario s = scenarioNamed("thesis-meadow", "fx32");
+  auto gpu = onPath(s, PhysicsPath::Gpu);
+  for (int t = 0; t < 30; ++t) ASSERT_TRUE(gpu->step(TickInput{}).ok);
+  EXPECT_EQ(gpu->deviceTraffic().toHost, 30 * 4);
+  EXPECT_NE(gpu->devicePatchDrawBuffer(), 0u);
+  (void)gpu->stateHash();
+  const int64_t particles = gpu->counts().particles();
+  // positions and velocities, and the displacement the host derives its patches from: 9 arrays
+  EXPECT_EQ(gpu->deviceTraffic().toHost, 30 * 4 + 9 * particles * 8);
+  EXPECT_NE(gpu->devicePatchDrawBuffer(), 0u) << "a copy back leaves the device's patches current";
+  gpu->restoreState(gpu->saveState());
+  EXPECT_EQ(gpu->devicePatchDrawBuffer(), 0u) << "the host set the state: the device's patches are stale";
+  ASSERT_TRUE(gpu->step(TickInput{}).ok);
+  EXPECT_NE(gpu->devicePatchDrawBuffer(), 0u);
+  // A level-of-detail window moving under the camera: the host writes the entering cells and
+  // sends just those up; nothing comes back.
+  Scenario moving = scenarioNamed("wind-fronts", "fx32");
+  moving.lod.mode = LodMode::Window;
+  moving.lod.windowX = moving.lod.windowZ = 31;
+  auto window = onPath(moving, PhysicsPath::Gpu);
+  TickInput in;
+  in.hasCamera = true;
+  for (int64_t t = 1; t <= 90; ++t) {
+    in.camera = {(-3600 + 40 * t) << 24, 0, (-3600 + 25 * t) << 24};
+    ASSERT_TRUE(window->step(in).ok);
+  }
+  EXPECT_GT(window->counts().windowOriginI, 0) << "the window was meant to move";
+  EXPECT_EQ(window->deviceTraffic().toHost, 90 * 4);
+  auto readback = onPath(s, PhysicsPath::GpuReadback);
+  ASSERT_TRUE(readback->step(TickInput{}).ok);
+  EXPECT_EQ(readback->devicePatchDrawBuffer(), 0u) << "gpu-readback derives the patches on the host";
+}
+
+/// `render --physics gpu`: the device lives in the renderer's context and the frames draw the
+/// tufts' tops from its buffer. The frames are the CPU's, byte for byte, and 60 ticks copy back
+/// 240 bytes: one fault word a tick.
+TEST(GpuPhysics, RenderDrawsTheDevicesTopsWithoutCopyingThemBack) {
+  TempDir dir;
+  const std::string scenario = quote(test::sourcePath("scenarios/thesis-meadow.json"));
+  for (const char* path : {"cpu", "gpu"}) {
+    const CliResult r = runCli("render " + scenario + " -o " + quote(dir.file(path)) +
+                               " --ticks 0:60:30 --size 200x120 --json --physics " + path);
+    ASSERT_EQ(r.exitCode, 0) << r.describe();
+    const json j = parseJson(r);
+    EXPECT_EQ(j.at("deviceBytesToHost").get<int64_t>(), std::string(path) == "gpu" ? 60 * 4 : 0) << r.out;
+  }
+  for (const char* frame : {"frame-000000.png", "frame-000030.png", "frame-000060.png"}) {
+    const std::vector<uint8_t> cpu = readBytes(dir.file(std::string("cpu/") + frame));
+    ASSERT_FALSE(cpu.empty()) << frame;
+    EXPECT_TRUE(cpu == readBytes(dir.file(std::string("gpu/") + frame))) << frame << " differs";
+  }
+  const CliResult bad = runCli("render " + scenario + " -o " + quote(dir.file("bad")) + " --physics cuda");
+  EXPECT_EQ(bad.exitCode, 2);
+  EXPECT_TRUE(isOneLine(bad.err));
+}
+
+/// The viewer runs the device in its window's GLX context (`--physics gpu`, the script's and the
+/// Physics panel's `physics`), switches paths mid-run with the state carried over, and draws the
+/// tufts from the device's buffer: the same pixels and hashes as a CPU session. A recording with
+/// `--physics gpu` is refused in one line before any window.
+TEST(GpuPhysics, TheViewerDrawsFromTheDeviceInItsOwnContext) {
+  TempDir dir;
+  const std::string scenario = quote(test::sourcePath("scenarios/wind-fronts.json"));
+  const std::string window = " --size 320x180 --msaa 0";
+  // The panels hidden (F2): they show timings. On the device from tick 0, to the CPU at tick 20
+  // and back at 30; drawn at tick 40 from the device's buffer.
+  dir.write("cpu.txt", "tap f2\nframes 40\nscreenshot " + dir.file("cpu.png") + "\nprint\nframes 10\nprint\nquit\n");
+  dir.write("gpu.txt", "tap f2\nframes 20\nphysics cpu\nframes 10\nphysics gpu\nframes 10\nscreenshot " +
+                           dir.file("gpu.png") +
+                           "\nprint\nphysics gpu-readback\nframes 5\nphysics cpu\nframes 5\nprint\nquit\n");
+  const CliResult cpu = viewer_test::runViewer(scenario + " --script " + quote(dir.file("cpu.txt")) + window);
+  const CliResult gpu =
+      viewer_test::runViewer(scenario + " --physics gpu --script " + quote(dir.file("gpu.txt")) + window);
+  ASSERT_EQ(cpu.exitCode, 0) << cpu.describe();
+  ASSERT_EQ(gpu.exitCode, 0) << gpu.describe();
+  const auto line = [](const std::string& out, size_t n) {
+    size_t at = 0;
+    for (size_t i = 0; i < n; ++i) at = out.find('\n', at) + 1;
+    return out.substr(at, out.find('\n', at) - at);
+  };
+  EXPECT_NE(line(cpu.out, 0).find("tick 40"), std::string::npos) << cpu.out;
+  EXPECT_EQ(line(gpu.out, 0), line(cpu.out, 0));  // tick 40: the same hash
+  EXPECT_EQ(line(gpu.out, 1), line(cpu.out, 1));  // tick 50, after gpu-readback and the CPU
+  const std::vector<uint8_t> a = readBytes(dir.file("cpu.png")), b = readBytes(dir.file("gpu.png"));
+  ASSERT_FALSE(a.empty());
+  EXPECT_TRUE(a == b) << "the frame drawn from the device differs from the CPU's";
+  const CliResult refused = viewer_test::runViewer(
+      quote(test::sourcePath("scenarios/recordings/thesis-meadow-fx32.sgr")) + " --physics gpu", false);
+  EXPECT_EQ(refused.exitCode, 2) << refused.describe();
+  EXPECT_TRUE(isOneLine(refused.err));
+}
+
+/// `sweep --physics cpu,gpu`: each fx32 row gets a device twin with the same errors (the same
+/// bits), double stays on the CPU (it has no device path), and the CSV and JSON name the path.
+TEST(GpuPhysics, SweepHasAPhysicsAxis) {
+  TempDir dir;
+  const CliResult r = runCli("sweep --scenarios " + quote(test::sourcePath("scenarios/sweep-bodies.json")) +
+                             " --scalars fx32,double --k 1 --dt 1/60 --lod off --physics cpu,gpu --seconds 0.25 "
+                             "--repeats 1 --json --out " +
+                             quote(dir.file("out")));
+  ASSERT_EQ(r.exitCode, 0) << r.describe();
+  const json j = parseJson(r);
+  std::map<std::string, json> rows;
+  for (const json& row : j.at("rows"))
+    rows[row.at("scalar").get<std::string>() + "/" + row.at("physics").get<std::string>()] = row;
+  ASSERT_EQ(rows.size(), 3u) << j.at("rows").dump();
+  ASSERT_TRUE(rows.count("fx32/gpu") && rows.count("fx32/cpu") && rows.count("double/cpu"));
+  for (const char* key : {"tip_rms_m", "tip_max_m", "body_pos_max_m"})
+    EXPECT_EQ(rows["fx32/gpu"].at(key), rows["fx32/cpu"].at(key)) << key;
+  EXPECT_NE(readFile(dir.file("out/sweep.csv")).find(",gpu\n"), std::string::npos);
+  const CliResult bad = runCli("sweep --scalars double --physics gpu --out " + quote(dir.file("bad")));
+  EXPECT_EQ(bad.exitCode, 2);
+  EXPECT_TRUE(isOneLine(bad.err));
 }
 
 /// What no golden runs on this path: the pbd constraint mode with gust fronts at k = 2, and the

@@ -169,7 +169,8 @@ const std::vector<std::string> kColumns{"scenario",
                                         "model_error_max_m",
                                         "pareto_model",
                                         "model_error_body_rms_m",
-                                        "model_error_body_max_m"};
+                                        "model_error_body_max_m",
+                                        "physics"};
 
 std::vector<std::map<std::string, std::string>> readCsv(const std::string& path) {
   std::istringstream in(readFile(path));

@@ -118,6 +118,8 @@ int runScenario(const RunOptions& o) {
     j["kernel"] = particleKernel;
     j["patchKernel"] = patchKernel;
     j["physics"] = describePhysics(*world);
+    j["deviceBytesToHost"] = world->deviceTraffic().toHost;  // 0 on the CPU (docs/gpu-physics.md)
+    j["deviceBytesToDevice"] = world->deviceTraffic().toDevice;
     j["counts"] = {{"patchesX", counts.patchesX},     {"patchesZ", counts.patchesZ},
                    {"patches", counts.patches()},     {"particlesX", counts.particlesX},
                    {"particlesZ", counts.particlesZ}, {"particles", counts.particles()},
@@ -147,7 +149,9 @@ int runScenario(const RunOptions& o) {
                                    patchKernel + " patch kernel";
     std::printf("scalar     %s, interpolation k=%d, %d thread%s, %s\n", scalarName(scenario.scalar),
                 counts.interpolation, counts.threads, counts.threads == 1 ? "" : "s", kernelText.c_str());
-    if (world->physicsPath() != PhysicsPath::Cpu) std::printf("physics    %s\n", describePhysics(*world).c_str());
+    if (world->physicsPath() != PhysicsPath::Cpu)
+      std::printf("physics    %s; copied %" PRId64 " bytes back, %" PRId64 " up\n", describePhysics(*world).c_str(),
+                  world->deviceTraffic().toHost, world->deviceTraffic().toDevice);
     std::printf(
         "patches    %" PRId64 " (%" PRId64 " x %" PRId64 "), particles %" PRId64 " (%" PRId64 " x %" PRId64 ")\n",
         counts.patches(), counts.patchesX, counts.patchesZ, counts.particles(), counts.particlesX, counts.particlesZ);

@@ -208,6 +208,10 @@ void addSweepCommand(CLI::App& app, int* exitCode) {
   cmd->add_option("--models", o->run.models,
                   "Grass models to sweep (subset of thesis,pbd,blade), each against its own reference; "
                   "default: each scenario's own model");
+  cmd->add_option("--physics", o->run.physics,
+                  "Where the grass stages run, swept (subset of cpu,gpu,gpu-readback; a device path takes the scalars "
+                  "that have one: not double; docs/gpu-physics.md)")
+      ->capture_default_str();
   cmd->add_option("--repeats", o->run.repeats, "Timed runs per variant (the cost is their median)")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();

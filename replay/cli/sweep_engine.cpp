@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +14,7 @@
 
 #include "replay/cli/divergence_report.h"
 #include "replay/lockstep.h"
+#include "replay/physics_devices.h"
 #include "replay/recorder.h"
 #include "replay/report/pareto.h"
 #include "replay/scenario_files.h"
@@ -108,6 +110,8 @@ Axes parseAxes(const Options& o) {
                                                   if (s == "brute") return ParticleBroadphase::Brute;
                                                   return std::nullopt;
                                                 });
+  a.physics = parseList<PhysicsPath>("--physics", o.physics, "a comma-separated list of cpu, gpu, gpu-readback",
+                                     [](const std::string& s) { return parsePhysicsPath(s); });
   a.models = {std::nullopt};
   if (!o.models.empty()) {
     const auto models = parseList<GrassModel>("--models", o.models, "a comma-separated list of thesis, pbd, blade",
@@ -133,16 +137,20 @@ VariantSettings referenceSettings() {
   return r;
 }
 
+PhysicsPath Row::physics() const { return settings.physics.value_or(PhysicsPath::Cpu); }
+
 std::string Row::label() const {
   return std::string(scalarName(*settings.scalar)) + " k" + std::to_string(*settings.interpolation) + " " +
          settings.timeStep->toString() + (*settings.lod == LodMode::Window ? " win" : "") +
-         (*settings.broadphase == ParticleBroadphase::Brute ? " brute" : "");
+         (*settings.broadphase == ParticleBroadphase::Brute ? " brute" : "") +
+         (physics() == PhysicsPath::Cpu ? "" : std::string(" ") + physicsPathName(physics()));
 }
 
 std::string Row::settingsText() const {
   return std::string("scalar=") + scalarName(*settings.scalar) + " interp=" + std::to_string(*settings.interpolation) +
          " dt=" + settings.timeStep->toString() + " lod=" + (*settings.lod == LodMode::Window ? "window" : "off") +
-         " broadphase=" + (*settings.broadphase == ParticleBroadphase::Brute ? "brute" : "grid");
+         " broadphase=" + (*settings.broadphase == ParticleBroadphase::Brute ? "brute" : "grid") +
+         (physics() == PhysicsPath::Cpu ? "" : std::string(" physics=") + physicsPathName(physics()));
 }
 
 namespace {
@@ -172,20 +180,36 @@ void listRows(Plan& plan) {
       for (int k : plan.axes.ks)
         for (const Rational& dt : plan.axes.dts)
           for (LodMode lod : plan.axes.lods)
-            for (ParticleBroadphase bp : plan.axes.broadphases) {
-              Row r;
-              r.scenario = s;
-              r.settings.scalar = scalar, r.settings.interpolation = k, r.settings.timeStep = dt;
-              r.settings.lod = lod, r.settings.broadphase = bp;
-              const auto e = plan.scenarios[s].modelError.find(dt.toString());  // measured, if asked
-              if (e != plan.scenarios[s].modelError.end()) r.modelError = e->second;
-              plan.rows.push_back(std::move(r));
-            }
+            for (ParticleBroadphase bp : plan.axes.broadphases)
+              for (PhysicsPath physics : plan.axes.physics) {
+                // double has no device path (docs/gpu-physics.md): its rows stay on the CPU only.
+                if (physics != PhysicsPath::Cpu && scalar == ScalarKind::Double) continue;
+                Row r;
+                r.scenario = s;
+                r.settings.scalar = scalar, r.settings.interpolation = k, r.settings.timeStep = dt;
+                r.settings.lod = lod, r.settings.broadphase = bp;
+                if (physics != PhysicsPath::Cpu) r.settings.physics = physics;
+                const auto e = plan.scenarios[s].modelError.find(dt.toString());  // measured, if asked
+                if (e != plan.scenarios[s].modelError.end()) r.modelError = e->second;
+                plan.rows.push_back(std::move(r));
+              }
 }
 }  // namespace
 
 Plan makePlan(const Options& o, bool measureTufts, const char* missingFileHint) {
   Plan plan = planTimes(o);
+  // A device path needs a device, and a scalar that has one (double has none).
+  for (PhysicsPath physics : plan.axes.physics) {
+    if (physics == PhysicsPath::Cpu) continue;
+    std::string error;
+    if (!gpuPhysicsProvider(&error))
+      throw std::invalid_argument(std::string("--physics ") + physicsPathName(physics) + ": " + error);
+    if (std::all_of(plan.axes.scalars.begin(), plan.axes.scalars.end(),
+                    [](ScalarKind s) { return s == ScalarKind::Double; }) &&
+        std::find(plan.axes.physics.begin(), plan.axes.physics.end(), PhysicsPath::Cpu) == plan.axes.physics.end())
+      throw std::invalid_argument(std::string("--physics ") + physicsPathName(physics) +
+                                  ": expected --scalars with fx32, fx16 or float (double has no device path)");
+  }
   const VariantSettings ref = referenceSettings();
   // Every scenario loads and takes every variant before anything runs. With --models, each
   // scenario is swept once per model, each against its own reference (the same model at the

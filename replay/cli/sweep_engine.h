@@ -28,7 +28,8 @@ struct Options {
   std::string scenarios = kDefaultScenarios;
   std::string scalars = "fx16,fx32,float,double", ks = "1,2,3,4", dts = "1/30,1/60,1/120,1/240", lods = "off,window";
   std::string broadphases = "grid";
-  std::string models;  ///< empty: each scenario's own grass model
+  std::string models;           ///< empty: each scenario's own grass model
+  std::string physics = "cpu";  ///< where the grass stages run (docs/gpu-physics.md)
   double seconds = 3.0;
   int repeats = 3, threads = 1;
 };
@@ -41,6 +42,7 @@ struct Axes {
   std::vector<LodMode> lods;
   std::vector<ParticleBroadphase> broadphases;
   std::vector<std::optional<GrassModel>> models;  ///< {nullopt}: each scenario's own
+  std::vector<PhysicsPath> physics;               ///< a device path takes the scalars that have one (not double)
 };
 
 /// Throws std::invalid_argument with "--k: expected 1, 2, 3 or 4, got '5'".
@@ -88,6 +90,8 @@ struct Row {
   std::string label() const;
   /// "scalar=fx32 interp=2 dt=1/60 lod=window broadphase=grid": the row's settings in full.
   std::string settingsText() const;
+  /// Where the row's grass stages run (cpu unless the physics axis chose a device).
+  PhysicsPath physics() const;
 };
 
 /// The whole sweep before it runs.

@@ -140,6 +140,7 @@ nlohmann::json rowJson(const Row& r, const std::string& scenario, GrassModel mod
           {"dt_s", r.dtSeconds()},
           {"lod", *r.settings.lod == LodMode::Window ? "window" : "off"},
           {"broadphase", *r.settings.broadphase == ParticleBroadphase::Brute ? "brute" : "grid"},
+          {"physics", physicsPathName(r.physics())},
           {"steps", r.steps},
           {"ms_per_tick", r.msPerTick},
           {"ms_per_simulated_second", r.msPerSimSecond},
@@ -212,13 +213,13 @@ int writeReport(const Plan& plan, const std::string& out, bool json) {
   const std::string csvHeader =
       "scenario,scalar,k,dt,dt_s,lod,broadphase,steps,ms_per_tick,ms_per_simulated_second,tip_rms_m,tip_max_m,"
       "body_pos_max_m,body_angle_max_rad,first_divergent_time,states_compared,status,pareto,pareto_tip_max,pareto_body,"
-      "model_error_rms_m,model_error_max_m,pareto_model,model_error_body_rms_m,model_error_body_max_m";
+      "model_error_rms_m,model_error_max_m,pareto_model,model_error_body_rms_m,model_error_body_max_m,physics";
   const double refDtS = refDt.toDouble();
   if (!writeCsv("sweep", csvPath, csvHeader, [&](std::FILE* f) {
         for (const Row& r : rows) {
           const nlohmann::json j = rowJson(r, scenarios[r.scenario].name, scenarios[r.scenario].model, refDtS);
           std::fprintf(
-              f, "%s,%s,%d,%s,%s,%s,%s,%" PRId64 ",%s,%s,%s,%s,%s,%s,%s,%" PRId64 ",%s,%d,%d,%d,%s,%s,%d,%s,%s\n",
+              f, "%s,%s,%d,%s,%s,%s,%s,%" PRId64 ",%s,%s,%s,%s,%s,%s,%s,%" PRId64 ",%s,%d,%d,%d,%s,%s,%d,%s,%s,%s\n",
               csvField(scenarios[r.scenario].name).c_str(), scalarName(*r.settings.scalar), *r.settings.interpolation,
               r.settings.timeStep->toString().c_str(), csvNumber(r.dtSeconds()).c_str(),
               j["lod"].get<std::string>().c_str(), j["broadphase"].get<std::string>().c_str(), r.steps,
@@ -228,13 +229,14 @@ int writeReport(const Plan& plan, const std::string& out, bool json) {
               csvNumber(j["first_divergent_time"].get<double>()).c_str(), r.summary.ticks, csvField(r.status()).c_str(),
               r.pareto ? 1 : 0, r.paretoTipMax ? 1 : 0, r.paretoBody ? 1 : 0, csvNumber(r.modelError.tipRms).c_str(),
               csvNumber(r.modelError.tipMax).c_str(), r.paretoModel ? 1 : 0, csvNumber(r.modelError.bodyRms).c_str(),
-              csvNumber(r.modelError.bodyMax).c_str());
+              csvNumber(r.modelError.bodyMax).c_str(), physicsPathName(r.physics()));
         }
       }))
     return kExitBadInput;
 
   nlohmann::json doc;
-  doc["reference"] = {{"scalar", "double"}, {"k", 1}, {"dt", refDt.toString()}, {"lod", "off"}, {"broadphase", "grid"}};
+  doc["reference"] = {{"scalar", "double"},   {"k", 1},          {"dt", refDt.toString()}, {"lod", "off"},
+                      {"broadphase", "grid"}, {"physics", "cpu"}};
   doc["seconds"] = double(ticks) * refDtS;
   doc["compareEvery_s"] = double(interval) * refDtS;
   doc["repeats"] = o.repeats;

@@ -58,6 +58,7 @@ json optionsJson(const Options& o) {
           {"lod", o.lods},
           {"broadphase", o.broadphases},
           {"models", o.models},
+          {"physics", o.physics},
           {"seconds", o.seconds},
           {"repeats", o.repeats},
           {"threads", o.threads}};
@@ -90,6 +91,7 @@ Options optionsFrom(const json& j, const std::string& file) {
   o.lods = field<std::string>(j, "lod", file, at);
   o.broadphases = field<std::string>(j, "broadphase", file, at);
   o.models = field<std::string>(j, "models", file, at);
+  o.physics = j.contains("physics") ? field<std::string>(j, "physics", file, at) : "cpu";  // older plans: none
   o.seconds = field<double>(j, "seconds", file, at);
   o.repeats = int(field<int64_t>(j, "repeats", file, at));
   o.threads = int(field<int64_t>(j, "threads", file, at));

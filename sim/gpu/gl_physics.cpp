@@ -7,19 +7,23 @@
 #include <cstring>
 #include <type_traits>
 
-#include "sim/gpu/osmesa_host.h"
 #include "sim/gpu/particle_pass_glsl.h"
 
 namespace sg::gpu {
 namespace {
 
-/// The headless context every device of one provider shares.
+/// The context every device of one provider shares (GlContextHooks): its own headless one, or
+/// whatever context is current when the provider is made and used (a renderer's, which then
+/// draws straight from the devices' buffers).
 struct ComputeContext {
-  void* context = nullptr;  ///< OSMesaContext
-  unsigned char buffer[4 * 4 * 4] = {};
+  GlContextHooks hooks;
   std::string description;
-  void makeCurrent() { makeOsmesaContextCurrent(context, buffer, 4); }
-  ~ComputeContext() { destroyOsmesaContext(context); }
+  void makeCurrent() {
+    if (hooks.makeCurrent) hooks.makeCurrent();
+  }
+  ~ComputeContext() {
+    if (hooks.destroy) hooks.destroy();
+  }
 };
 
 std::string glString(GLenum name) {
@@ -71,6 +75,8 @@ enum Binding : GLuint {
   kTrampleIn,
   kTrampleOut
 };
+// The patch pass's bindings (kPatchPassGlsl).
+enum PatchBinding : GLuint { kPatchDisplacement, kPatchConstants, kPatchRootY, kPatchCut, kPatchOut, kPatchDraw };
 
 /// What a value of S is stored as in the buffers: a fixed-point value is its raw integer, a float
 /// itself.
@@ -78,11 +84,13 @@ template <class S>
 struct Stored {
   using Type = typename S::RawType;
   static Type of(S v) { return v.raw(); }
+  static S value(Type r) { return S::fromRaw(r); }
 };
 template <>
 struct Stored<float> {
   using Type = float;
   static float of(float v) { return v; }
+  static float value(float r) { return r; }
 };
 
 /// One world's particles in shader storage buffers, and the pass over them. Positions,
@@ -94,9 +102,14 @@ class GlParticleDevice final : public ParticleDevice<S> {
   static_assert(sizeof(S) == sizeof(Raw) && std::is_trivially_copyable_v<S>, "a value is stored as itself");
 
  public:
-  GlParticleDevice(std::shared_ptr<ComputeContext> context, GLuint program, int64_t countX, int64_t countZ,
-                   bool tramples)
-      : context_(std::move(context)), program_(program), countX_(countX), countZ_(countZ), tramples_(tramples) {
+  GlParticleDevice(std::shared_ptr<ComputeContext> context, GLuint program, GLuint patchProgram, int64_t countX,
+                   int64_t countZ, bool tramples)
+      : context_(std::move(context)),
+        program_(program),
+        patchProgram_(patchProgram),
+        countX_(countX),
+        countZ_(countZ),
+        tramples_(tramples) {
     for (GLuint* b : buffers()) glCreateBuffers(1, b);
     for (GLuint b : {position_[0], position_[1], velocity_[0], velocity_[1], anchor_, displacement_})
       glNamedBufferData(b, 3 * arrayBytes(), nullptr, GL_DYNAMIC_COPY);
@@ -147,6 +160,7 @@ class GlParticleDevice final : public ParticleDevice<S> {
     replaceContents(runBuffer_, runs_, &runCapacity_);
     const GLuint none = 0xFFFFFFFFu;
     glNamedBufferSubData(fault_, 0, sizeof none, &none);
+    traffic_.toDevice += GLsizeiptr(tick_.size() * sizeof(Raw) + runs_.size() * sizeof(int32_t) + sizeof none);
     glUseProgram(program_);
     const GLuint next = 1 - current_;
     const std::pair<Binding, GLuint> bindings[] = {{kPositionIn, position_[current_]},
@@ -171,6 +185,7 @@ class GlParticleDevice final : public ParticleDevice<S> {
     // must report at this tick.
     GLuint key = none;
     glGetNamedBufferSubData(fault_, 0, sizeof key, &key);
+    traffic_.toHost += sizeof key;
     *faultBits = 0;
     if (key == none) {
       current_ = next;
@@ -197,6 +212,17 @@ class GlParticleDevice final : public ParticleDevice<S> {
     if (tramples_) put(trample_[current_], {&p.trample}, rows);
   }
 
+  void uploadCells(const ParticleArrays<S>& p, const std::vector<typename ParticleDevice<S>::Span>& spans) override {
+    context_->makeCurrent();
+    for (const auto& s : spans) {
+      const Span cells{s.first, s.count};
+      put(position_[current_], {&p.px, &p.py, &p.pz}, cells);
+      put(velocity_[current_], {&p.vx, &p.vy, &p.vz}, cells);
+      put(anchor_, {&p.anchorX, &p.anchorY, &p.anchorZ}, cells);
+      if (tramples_) put(trample_[current_], {&p.trample}, cells);
+    }
+  }
+
   void download(ParticleArrays<S>& p, std::vector<S>* dx, std::vector<S>* dy, std::vector<S>* dz) override {
     context_->makeCurrent();
     get(position_[current_], {&p.px, &p.py, &p.pz});
@@ -204,6 +230,74 @@ class GlParticleDevice final : public ParticleDevice<S> {
     if (tramples_) get(trample_[current_], {&p.trample});
     if (dx) get(displacement_, {dx, dy, dz});
   }
+
+  void derivePatches(const DevicePatchInputs<S>& in) override {
+    context_->makeCurrent();
+    const int64_t patchCount = in.patches.size();
+    if (patchCount != patchCount_) {  // the window's size is fixed: allocated once per world
+      patchCount_ = patchCount;
+      glNamedBufferData(rootY_, patchCount * GLsizeiptr(sizeof(Raw)), nullptr, GL_DYNAMIC_DRAW);
+      glNamedBufferData(cut_, patchCount * GLsizeiptr(sizeof(GLuint)), nullptr, GL_DYNAMIC_DRAW);
+      glNamedBufferData(patchOut_, 4 * patchCount * GLsizeiptr(sizeof(Raw)), nullptr, GL_DYNAMIC_COPY);
+      glNamedBufferData(patchDraw_, patchCount * GLsizeiptr(4 * sizeof(float)), nullptr, GL_DYNAMIC_COPY);
+      patchRevision_ = 0;
+    }
+    const PatchStateConstants<S>& c = *in.constants;
+    using St = Stored<S>;
+    patchConstants_.assign({St::of(c.halfRod), St::of(c.scaleY), St::of(c.cutReduction), St::of(c.minimumTop),
+                            St::of(c.drop[0]), St::of(c.drop[1]), St::of(c.drop[2])});
+    for (const S& w : c.weight) patchConstants_.push_back(St::of(w));
+    replaceContents(patchConstantBuffer_, patchConstants_, &patchConstantCapacity_);
+    traffic_.toDevice += GLsizeiptr(patchConstants_.size() * sizeof(Raw));
+    if (in.revision != patchRevision_) {  // a window move, a cut, a restore
+      patchRevision_ = in.revision;
+      static_assert(sizeof(S) == sizeof(Raw));
+      glNamedBufferSubData(rootY_, 0, patchCount * GLsizeiptr(sizeof(Raw)), in.rootY->data());
+      cutWords_.assign(in.cut->begin(), in.cut->end());
+      glNamedBufferSubData(cut_, 0, patchCount * GLsizeiptr(sizeof(GLuint)), cutWords_.data());
+      traffic_.toDevice += patchCount * GLsizeiptr(sizeof(Raw) + sizeof(GLuint));
+    }
+    glUseProgram(patchProgram_);
+    const std::pair<PatchBinding, GLuint> bindings[] = {{kPatchDisplacement, displacement_},
+                                                        {kPatchConstants, patchConstantBuffer_},
+                                                        {kPatchRootY, rootY_},
+                                                        {kPatchCut, cut_},
+                                                        {kPatchOut, patchOut_},
+                                                        {kPatchDraw, patchDraw_}};
+    for (const auto& [binding, buffer] : bindings) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer);
+    const auto window = [](const LatticeWindow& w) {
+      return std::array<GLint, 4>{GLint(w.originI), GLint(w.originJ), GLint(w.sizeI), GLint(w.sizeJ)};
+    };
+    const GLuint p = patchProgram_;
+    glUniform1i(glGetUniformLocation(p, "k"), GLint(c.k));
+    glUniform4iv(glGetUniformLocation(p, "particleWindow"), 1, window(in.particles).data());
+    glUniform4iv(glGetUniformLocation(p, "patchWindow"), 1, window(in.patches).data());
+    glUniform2i(glGetUniformLocation(p, "patchStorageOrigin"), GLint(in.patches.storageColumn(in.patches.originI)),
+                GLint(in.patches.storageRow(in.patches.originJ)));
+    glUniform1ui(glGetUniformLocation(p, "patchCount"), GLuint(patchCount));
+    glUniform1ui(glGetUniformLocation(p, "particleCount"), GLuint(countX_ * countZ_));
+    glDispatchCompute(GLuint((patchCount + 255) / 256), 1, 1);
+    // A renderer reads the draw copy as a vertex attribute or a buffer texture.
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT |
+                    GL_TEXTURE_FETCH_BARRIER_BIT);
+  }
+
+  void downloadPatches(PatchArrays<S>& patches) override {
+    context_->makeCurrent();
+    std::vector<Raw> out(size_t(4 * patchCount_));
+    glGetNamedBufferSubData(patchOut_, 0, GLsizeiptr(out.size() * sizeof(Raw)), out.data());
+    traffic_.toHost += GLsizeiptr(out.size() * sizeof(Raw));
+    const size_t n = size_t(patchCount_);
+    for (size_t q = 0; q < n; ++q) {
+      patches.tipOffsetX[q] = Stored<S>::value(out[q]);
+      patches.tipOffsetZ[q] = Stored<S>::value(out[n + q]);
+      patches.topY[q] = Stored<S>::value(out[2 * n + q]);
+      patches.tiltLevel[q] = uint8_t(out[3 * n + q]);
+    }
+  }
+
+  uint32_t patchDrawBuffer() const override { return patchCount_ > 0 ? patchDraw_ : 0; }
+  DeviceTraffic traffic() const override { return traffic_; }
 
  private:
   /// Particles [first, first + count) of every array of a buffer.
@@ -218,6 +312,7 @@ class GlParticleDevice final : public ParticleDevice<S> {
     for (const std::vector<S>* a : arrays) {
       glNamedBufferSubData(buffer, at, GLsizeiptr(count) * GLsizeiptr(sizeof(Raw)), a->data() + span.first);
       at += arrayBytes();
+      traffic_.toDevice += GLsizeiptr(count) * GLsizeiptr(sizeof(Raw));
     }
   }
   void get(GLuint buffer, std::initializer_list<std::vector<S>*> arrays, Span span = {}) {
@@ -226,6 +321,7 @@ class GlParticleDevice final : public ParticleDevice<S> {
     for (std::vector<S>* a : arrays) {
       glGetNamedBufferSubData(buffer, at, GLsizeiptr(count) * GLsizeiptr(sizeof(Raw)), a->data() + span.first);
       at += arrayBytes();
+      traffic_.toHost += GLsizeiptr(count) * GLsizeiptr(sizeof(Raw));
     }
   }
 
@@ -257,13 +353,14 @@ class GlParticleDevice final : public ParticleDevice<S> {
     return {row * countX_, Stage::Integrate};  // unreachable: the runs cover the row
   }
 
-  std::array<GLuint*, 11> buffers() {
+  std::array<GLuint*, 16> buffers() {
     return {&position_[0], &position_[1],  &velocity_[0], &velocity_[1], &trample_[0], &trample_[1],
-            &anchor_,      &displacement_, &tickBuffer_,  &runBuffer_,   &fault_};
+            &anchor_,      &displacement_, &tickBuffer_,  &runBuffer_,   &fault_,      &patchConstantBuffer_,
+            &rootY_,       &cut_,          &patchOut_,    &patchDraw_};
   }
 
   std::shared_ptr<ComputeContext> context_;
-  GLuint program_ = 0;
+  GLuint program_ = 0, patchProgram_ = 0;
   GLuint position_[2] = {}, velocity_[2] = {};  ///< x, y and z in each
   GLuint trample_[2] = {};                      ///< 16 bytes each without trampling
   GLuint anchor_ = 0, displacement_ = 0;        ///< x, y and z in each
@@ -275,17 +372,28 @@ class GlParticleDevice final : public ParticleDevice<S> {
   bool tramples_ = false;
   std::vector<Raw> tick_;
   std::vector<int32_t> runs_;
+  // The patch stage (derivePatches): per patch slot, the inputs (root height, cut flag as a
+  // 32-bit word) copied when their revision changes, and the outputs.
+  GLuint patchConstantBuffer_ = 0, rootY_ = 0, cut_ = 0, patchOut_ = 0, patchDraw_ = 0;
+  GLsizeiptr patchConstantCapacity_ = 0;
+  int64_t patchCount_ = 0;
+  uint64_t patchRevision_ = 0;  ///< of the inputs on the device (0: none)
+  std::vector<Raw> patchConstants_;
+  std::vector<GLuint> cutWords_;
+  DeviceTraffic traffic_;
 };
 
-class OsmesaPhysicsProvider final : public ParticleDeviceProvider {
+class GlPhysicsProvider final : public ParticleDeviceProvider {
  public:
-  explicit OsmesaPhysicsProvider(std::shared_ptr<ComputeContext> context) : context_(std::move(context)) {}
-  ~OsmesaPhysicsProvider() override {
+  explicit GlPhysicsProvider(std::shared_ptr<ComputeContext> context) : context_(std::move(context)) {}
+  ~GlPhysicsProvider() override {
     context_->makeCurrent();
     for (auto& byModel : programs_)
       for (auto& byTrample : byModel)
         for (GLuint p : byTrample)
           if (p) glDeleteProgram(p);
+    for (GLuint p : patchPrograms_)
+      if (p) glDeleteProgram(p);
   }
 
   std::unique_ptr<ParticleDevice<Fx32>> makeFx32(int64_t countX, int64_t countZ, GrassModel model, bool tramples,
@@ -321,17 +429,22 @@ class OsmesaPhysicsProvider final : public ParticleDeviceProvider {
     tramples = tramples && model == GrassModel::Blade;
     const int format = std::is_same_v<S, Fx32> ? 0 : std::is_same_v<S, Fx16> ? 1 : 2;
     GLuint& program = programs_[format][modelIndex][tramples ? 1 : 0];
+    const std::string prelude = std::string("#version 450\n#extension GL_ARB_gpu_shader_int64 : require\n") +
+                                "#define FX32 " + (format == 0 ? "1" : "0") + "\n#define FLOAT " +
+                                (format == 2 ? "1" : "0") + "\n#define MODEL " + std::to_string(modelIndex) +
+                                "\n#define TRAMPLE " + (tramples ? "1" : "0") + "\n";
     if (!program) {
-      const std::string prelude = std::string("#version 450\n#extension GL_ARB_gpu_shader_int64 : require\n") +
-                                  "#define FX32 " + (format == 0 ? "1" : "0") + "\n#define FLOAT " +
-                                  (format == 2 ? "1" : "0") + "\n#define MODEL " + std::to_string(modelIndex) +
-                                  "\n#define TRAMPLE " + (tramples ? "1" : "0") + "\n";
-      program = buildProgram(prelude + kParticlePassGlsl, error);
+      program = buildProgram(prelude + kScalarGlsl + kParticlePassGlsl, error);
       if (!program) return nullptr;
+    }
+    GLuint& patchProgram = patchPrograms_[format];
+    if (!patchProgram) {
+      patchProgram = buildProgram(prelude + kScalarGlsl + kPatchPassGlsl, error);
+      if (!patchProgram) return nullptr;
     }
     while (glGetError() != GL_NO_ERROR) {
     }
-    auto device = std::make_unique<GlParticleDevice<S>>(context_, program, countX, countZ, tramples);
+    auto device = std::make_unique<GlParticleDevice<S>>(context_, program, patchProgram, countX, countZ, tramples);
     if (!device->ok()) {
       *error = "GPU physics: the device could not allocate buffers for " + std::to_string(n) + " particles";
       return nullptr;
@@ -341,22 +454,33 @@ class OsmesaPhysicsProvider final : public ParticleDeviceProvider {
 
   std::shared_ptr<ComputeContext> context_;
   GLuint programs_[3][3][2] = {};  ///< [fx32, fx16, float][thesis, pbd, blade][trample]
+  GLuint patchPrograms_[3] = {};   ///< [fx32, fx16, float]
 };
 
-}  // namespace
-
-std::unique_ptr<ParticleDeviceProvider> makeOsmesaPhysicsProvider(std::string* error) {
-  auto context = std::make_shared<ComputeContext>();
-  context->context = createOsmesaCoreContext(4, 5, 0, context->buffer, 4, error);
-  if (!context->context) return nullptr;
+/// A provider over `context` once it is current, or nullptr when it lacks what the passes need.
+std::unique_ptr<ParticleDeviceProvider> providerOn(std::shared_ptr<ComputeContext> context, const char* whose,
+                                                   std::string* error) {
   if (!GLEW_ARB_compute_shader || !GLEW_ARB_gpu_shader_int64 || !GLEW_ARB_gpu_shader_fp64 ||
       !GLEW_ARB_direct_state_access) {
     *error = "GPU physics: the OpenGL context (" + glString(GL_RENDERER) +
              ") lacks compute shaders, 64-bit integers, doubles or direct state access";
     return nullptr;
   }
-  context->description = "OpenGL " + glString(GL_VERSION) + " compute on " + glString(GL_RENDERER);
-  return std::make_unique<OsmesaPhysicsProvider>(std::move(context));
+  context->description = "OpenGL " + glString(GL_VERSION) + " compute on " + glString(GL_RENDERER) + whose;
+  return std::make_unique<GlPhysicsProvider>(std::move(context));
+}
+}  // namespace
+
+std::unique_ptr<ParticleDeviceProvider> makeGlPhysicsProvider(GlContextHooks hooks, const std::string& whose,
+                                                              std::string* error) {
+  auto context = std::make_shared<ComputeContext>();
+  context->hooks = std::move(hooks);
+  context->makeCurrent();
+  return providerOn(std::move(context), whose.c_str(), error);
+}
+
+std::unique_ptr<ParticleDeviceProvider> makeCurrentContextPhysicsProvider(std::string* error) {
+  return makeGlPhysicsProvider({}, ", the renderer's context", error);
 }
 
 }  // namespace sg::gpu

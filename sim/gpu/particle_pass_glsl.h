@@ -1,8 +1,8 @@
-// The fused particle pass (sim/particles/particle_row.h) as an OpenGL 4.3 compute shader, one
-// invocation per particle, in the fixed-point formats' exact integer arithmetic
-// (GL_ARB_gpu_shader_int64). Each operation gives sim/math/fixed.h's bits and raises the same
-// overflow: sums wrap and are checked by sign; products round to nearest, ties away from zero,
-// Q32.32's 128-bit product built from 32 x 32 -> 64 partial products; L / |d| and |d| are guessed
+// The fused particle pass (sim/particles/particle_row.h) and the patch stage
+// (sim/patches/patch_state.h) as OpenGL 4.3 compute shaders, one invocation per particle or
+// patch, in the fixed-point formats' exact integer arithmetic (GL_ARB_gpu_shader_int64). Each operation gives
+// sim/math/fixed.h's bits and raises the same overflow: sums wrap and are checked by sign; products round to nearest,
+// ties away from zero, Q32.32's 128-bit product built from 32 x 32 -> 64 partial products; L / |d| and |d| are guessed
 // in double precision and then settled in exact integer arithmetic (the guess only decides how
 // many correction steps run, never the result). The prelude gl_physics.cpp puts before this text
 // defines FLOAT (1: float, the comparison variant), FX32 (1: Q32.32; both 0: Q16.16), MODEL
@@ -11,9 +11,9 @@
 
 namespace sg::gpu {
 
-inline constexpr const char* kParticlePassGlsl = R"GLSL(
-layout(local_size_x = 256) in;
-
+/// The scalar format's arithmetic, shared by the particle pass and the patch pass: RAW (a value's
+/// stored type) and the checked operations, each with fixed.h's bits (its fault in `overflowed`).
+inline constexpr const char* kScalarGlsl = R"GLSL(
 #if FLOAT
 #define RAW float
 #define ONE 1.0
@@ -24,32 +24,6 @@ layout(local_size_x = 256) in;
 #define RAW int
 #define ONE (1 << 16)
 #endif
-
-// Each buffer holds three arrays of `count` values (x, then y, then z). The pass reads one set of
-// positions and velocities and writes the other: a pass that faults leaves the tick's input
-// intact, so the CPU reference can redo that tick (docs/gpu-physics.md, "Faults").
-layout(std430, binding = 0) readonly buffer PositionIn { RAW positionIn[]; };
-layout(std430, binding = 1) readonly buffer VelocityIn { RAW velocityIn[]; };
-layout(std430, binding = 2) writeonly buffer PositionOut { RAW positionOut[]; };
-layout(std430, binding = 3) writeonly buffer VelocityOut { RAW velocityOut[]; };
-layout(std430, binding = 4) readonly buffer Anchor { RAW anchor[]; };
-layout(std430, binding = 5) writeonly buffer Displacement { RAW displacement[]; };
-// [0..7]: dt, damping per tick, rod length, 1/dt, blade stiffness dt, blade damping per tick,
-// trample decay per tick, 1/L (ParticleConstants); then run k's (a + F/m) dt at 8 + 3k (x, y, z).
-layout(std430, binding = 6) readonly buffer Tick { RAW tickData[]; };
-// The smallest fault key (0xffffffff: none); see faultKey() below.
-layout(std430, binding = 7) buffer Fault { uint faultKey; };
-// [0..countZ]: row r's wind runs are [runs[r], runs[r + 1]); run k covers columns
-// [runs[countZ + 1 + 2k], runs[countZ + 2 + 2k]).
-layout(std430, binding = 8) readonly buffer Runs { uint runs[]; };
-#if TRAMPLE
-layout(std430, binding = 9) readonly buffer TrampleIn { RAW trampleIn[]; };
-layout(std430, binding = 10) writeonly buffer TrampleOut { RAW trampleOut[]; };
-#endif
-
-uniform uint countX;
-uniform uint countZ;
-uniform uint count;
 
 bool overflowed;  // this invocation's fault bit (Fixed's kFixedFaultOverflow)
 
@@ -220,6 +194,37 @@ RAW length3(RAW x, RAW y, RAW z) {
 void checkFinite(RAW a, RAW b, RAW c, RAW d, RAW e, RAW f) {}  // every fixed-point value is finite
 #endif
 
+)GLSL";
+
+inline constexpr const char* kParticlePassGlsl = R"GLSL(
+layout(local_size_x = 256) in;
+
+// Each buffer holds three arrays of `count` values (x, then y, then z). The pass reads one set of
+// positions and velocities and writes the other: a pass that faults leaves the tick's input
+// intact, so the CPU reference can redo that tick (docs/gpu-physics.md, "Faults").
+layout(std430, binding = 0) readonly buffer PositionIn { RAW positionIn[]; };
+layout(std430, binding = 1) readonly buffer VelocityIn { RAW velocityIn[]; };
+layout(std430, binding = 2) writeonly buffer PositionOut { RAW positionOut[]; };
+layout(std430, binding = 3) writeonly buffer VelocityOut { RAW velocityOut[]; };
+layout(std430, binding = 4) readonly buffer Anchor { RAW anchor[]; };
+layout(std430, binding = 5) writeonly buffer Displacement { RAW displacement[]; };
+// [0..7]: dt, damping per tick, rod length, 1/dt, blade stiffness dt, blade damping per tick,
+// trample decay per tick, 1/L (ParticleConstants); then run k's (a + F/m) dt at 8 + 3k (x, y, z).
+layout(std430, binding = 6) readonly buffer Tick { RAW tickData[]; };
+// The smallest fault key (0xffffffff: none); see faultKey() below.
+layout(std430, binding = 7) buffer Fault { uint faultKey; };
+// [0..countZ]: row r's wind runs are [runs[r], runs[r + 1]); run k covers columns
+// [runs[countZ + 1 + 2k], runs[countZ + 2 + 2k]).
+layout(std430, binding = 8) readonly buffer Runs { uint runs[]; };
+#if TRAMPLE
+layout(std430, binding = 9) readonly buffer TrampleIn { RAW trampleIn[]; };
+layout(std430, binding = 10) writeonly buffer TrampleOut { RAW trampleOut[]; };
+#endif
+
+uniform uint countX;
+uniform uint countZ;
+uniform uint count;
+
 void noteFault(uint key) { atomicMin(faultKey, key); }
 
 void main() {
@@ -334,6 +339,96 @@ void main() {
   displacement[i] = nx - ax;
   displacement[j] = ny - ay - rod;
   displacement[l] = nz - az;
+}
+)GLSL";
+
+/// The patch stage (sim/patches/patch_state.h) as a compute shader, one invocation per patch slot:
+/// the tip displacement interpolated from the particles around the patch (along z between two
+/// particle rows, then along x, weights t/k: updatePatchRow's order), then PatchWriter's tip
+/// offset, top and tilt. Patch-stage data is never checked, so every operation wraps as Fixed's
+/// operators return it. Besides the exact values, a float copy for a renderer in the same
+/// context (ParticleDevice::patchDrawBuffer). Put after kScalarGlsl.
+inline constexpr const char* kPatchPassGlsl = R"GLSL(
+layout(local_size_x = 256) in;
+
+// The last particle pass's tip displacement: x, y and z arrays of particleCount values.
+layout(std430, binding = 0) readonly buffer Displacement { RAW displacement[]; };
+// [0..6]: half rod, scaleY, cut reduction, minimum top, drop[0..2] (PatchStateConstants); then
+// weight[t] = t / k for t = 0..k-1.
+layout(std430, binding = 1) readonly buffer PatchConstants { RAW patchConstants[]; };
+layout(std430, binding = 2) readonly buffer RootY { RAW rootY[]; };     // per patch slot
+layout(std430, binding = 3) readonly buffer Cut { uint cutFlags[]; };   // per patch slot: 1 mown
+// Tip offset x, tip offset z, top y, tilt level: four arrays of patchCount values.
+layout(std430, binding = 4) writeonly buffer PatchOut { RAW patchOut[]; };
+layout(std430, binding = 5) writeonly buffer PatchDraw { vec4 patchDraw[]; };
+
+uniform int k;
+uniform ivec4 particleWindow;        // originI, originJ, sizeI, sizeJ (lattice_window.h)
+uniform ivec4 patchWindow;
+uniform ivec2 patchStorageOrigin;    // storage column of patchWindow's originI, storage row of originJ
+uniform uint patchCount;
+uniform uint particleCount;
+
+#if FLOAT
+RAW blend(RAW a, RAW b, RAW w) { precise RAW d = b - a; precise RAW p = d * w; precise RAW r = a + p; return r; }
+float toMetres(RAW v) { return v; }
+#else
+// Fixed's lerp, a + (b - a) w: the product rounded as Fixed's (mulChecked's bits; its fault is
+// ignored), the sums wrapping.
+RAW blend(RAW a, RAW b, RAW w) { return a + mulChecked(b - a, w); }
+// As the scene extraction converts (double(raw) / 2^frac, then rounded to float).
+float toMetres(RAW v) { return float(double(v) / double(ONE)); }
+#endif
+
+void main() {
+  uint p = gl_GlobalInvocationID.x;
+  if (p >= patchCount) return;
+  // The patch's lattice coordinates (LatticeWindow::latticeColumn / latticeRow; all >= 0).
+  int slotRow = int(p) / patchWindow.z, slotColumn = int(p) - slotRow * patchWindow.z;
+  int i = patchWindow.x + (slotColumn - patchStorageOrigin.x + patchWindow.z) % patchWindow.z;
+  int j = patchWindow.y + (slotRow - patchStorageOrigin.y + patchWindow.w) % patchWindow.w;
+  // The particles around it: columns a0 and a0 + 1, rows b0 and b0 + 1, in storage order.
+  int a0 = i / k, tx = i - a0 * k, b0 = j / k, tz = j - b0 * k;
+  int nx = particleWindow.z;
+  int r0 = (b0 % particleWindow.w) * nx, r1 = ((b0 + 1) % particleWindow.w) * nx;
+  int sa = a0 % nx, sb = sa + 1 == nx ? 0 : sa + 1;
+  RAW d[3];
+  for (int axis = 0; axis < 3; ++axis) {
+    int base = axis * int(particleCount);
+    RAW va = displacement[base + r0 + sa];
+    if (tz != 0) va = blend(va, displacement[base + r1 + sa], patchConstants[7 + tz]);
+    if (tx != 0) {
+      RAW vb = displacement[base + r0 + sb];
+      if (tz != 0) vb = blend(vb, displacement[base + r1 + sb], patchConstants[7 + tz]);
+      va = blend(va, vb, patchConstants[7 + tx]);
+    }
+    d[axis] = va;
+  }
+  // PatchWriter: the tuft gets shorter as the tip sinks (never below the minimum top), and
+  // darker in tilt steps.
+  RAW halfRod = patchConstants[0], scaleY = patchConstants[1], cutReduction = patchConstants[2];
+  RAW minimumTop = patchConstants[3];
+  bool cut = cutFlags[p] != 0u;
+#if FLOAT
+  precise RAW sink = RAW(0) - d[1];
+#else
+  RAW sink = RAW(0) - d[1];
+#endif
+  RAW smaller = sink < RAW(0) ? RAW(0) : (sink > halfRod ? halfRod : sink);
+#if FLOAT
+  precise RAW shorter = scaleY - smaller;
+  precise RAW top = shorter - (cut ? cutReduction : RAW(0));
+  precise RAW topY = rootY[p] + (top < minimumTop ? minimumTop : top);
+#else
+  RAW top = scaleY - smaller - (cut ? cutReduction : RAW(0));
+  RAW topY = rootY[p] + (top < minimumTop ? minimumTop : top);
+#endif
+  uint tilt = sink > patchConstants[6] ? 3u : sink > patchConstants[5] ? 2u : sink > patchConstants[4] ? 1u : 0u;
+  patchOut[p] = d[0];
+  patchOut[patchCount + p] = d[2];
+  patchOut[2u * patchCount + p] = topY;
+  patchOut[3u * patchCount + p] = RAW(tilt);
+  patchDraw[p] = vec4(toMetres(topY), toMetres(d[0]), toMetres(d[2]), float(cut ? 3u : tilt));
 }
 )GLSL";
 

@@ -58,4 +58,27 @@ void forEachEnteringCell(const LatticeWindow& now, const LatticeWindow& before, 
   for (int64_t i = std::max(now.originI, before.endI()); i < now.endI(); ++i) enter(i, j);
 }
 
+/// The cells forEachEnteringCell(now, before, false, ...) visits, as runs contiguous in storage:
+/// span(first storage index, count), a row new to the window as one run, a held row's entering
+/// columns as one or two (split where they wrap round the storage row).
+template <class Fn>
+void forEachEnteringSpan(const LatticeWindow& now, const LatticeWindow& before, Fn&& span) {
+  for (int64_t j = now.originJ; j < now.endJ(); ++j) {
+    const int64_t rowStart = now.storageRow(j) * now.sizeI;
+    const auto columns = [&](int64_t i0, int64_t i1) {  // lattice columns [i0, i1), held by `now`
+      while (i0 < i1) {
+        const int64_t c = now.storageColumn(i0), n = std::min(i1 - i0, now.sizeI - c);
+        span(rowStart + c, n);
+        i0 += n;
+      }
+    };
+    if (j < before.originJ || j >= before.endJ()) {
+      columns(now.originI, now.endI());
+      continue;
+    }
+    columns(now.originI, std::min(now.endI(), before.originI));
+    columns(std::max(now.originI, before.endI()), now.endI());
+  }
+}
+
 }  // namespace sg

@@ -53,6 +53,7 @@ void World<S>::initPatch(int64_t i, int64_t j) {
     patches_.variant[p] = uint8_t(lattice_.atlasVariants);
   // Mown tufts stay mown: the cut lives in the persistent world data, not in the window.
   patches_.cut[p] = cuts_.count({i, j}) ? 1 : 0;
+  ++patchInputsRevision_;  // a device's patch stage copies the roots and cuts again
 }
 
 template <class S>
@@ -62,10 +63,16 @@ void World<S>::fillWindow(int64_t originI, int64_t originJ, bool initialVelocity
 
 template <class S>
 void World<S>::moveWindowTo(int64_t originI, int64_t originJ, bool initialVelocity, bool everything) {
-  // On a device (world_device.cpp) the particles come back whole before the window writes its
-  // entering cells, and go up whole (anchors included) before the next pass.
-  syncFromDevice();
-  if (device_) hostAhead_ = true;
+  // On a device (world_device.cpp) nothing comes back: the host writes the entering cells into its
+  // arrays (each a function of its lattice coordinates alone) and sends up just those, whether
+  // the rest of the host's arrays is current or not. (`everything`, or a host already ahead,
+  // sends the whole state before the next pass.)
+  const bool cellsOnly = device_ && !hostAhead_ && !everything;
+  if (device_ && !cellsOnly) {
+    syncFromDevice();
+    hostAhead_ = true;
+  }
+  if (device_) deviceDisplacementCurrent_ = false;  // the next pass's, for the new window
   const LatticeWindow oldParticles = grid_.window, oldPatches = patchWindow_;
   grid_.window.originI = originI;
   grid_.window.originJ = originJ;
@@ -78,6 +85,15 @@ void World<S>::moveWindowTo(int64_t originI, int64_t originJ, bool initialVeloci
     pool_->run(now.sizeJ, [&](int64_t r, int) { forEachEnteringCell(now, before, everything, r, init); });
   };
   fill(grid_.window, oldParticles, [&](int64_t I, int64_t J) { initParticle(I, J, initialVelocity); });
+  if (cellsOnly) {
+    flushRowsToDevice();
+    thread_local std::vector<typename ParticleDevice<S>::Span> spans;
+    spans.clear();
+    forEachEnteringSpan(grid_.window, oldParticles, [&](int64_t first, int64_t count) {
+      spans.push_back({first, count});
+    });
+    device_->uploadCells(particles_, spans);
+  }
   fill(patchWindow_, oldPatches, [&](int64_t i, int64_t j) { initPatch(i, j); });
   if (lodWindow_)
     edgeRing_.follow(

@@ -11,10 +11,12 @@
 #include <string>
 #include <vector>
 
+#include "sim/lod/lattice_window.h"
 #include "sim/math/scalar.h"
 #include "sim/particles/particle_kernel.h"
 #include "sim/particles/particle_row.h"
 #include "sim/particles/particles.h"
+#include "sim/patches/patch_state.h"
 #include "sim/scenario/scenario.h"
 
 namespace sg {
@@ -26,6 +28,19 @@ struct DeviceWind {
   std::vector<int32_t> rowFirstRun;  ///< countZ + 1 entries: row r's runs are [rowFirstRun[r], rowFirstRun[r + 1])
   std::vector<int32_t> runBegin;     ///< per run: the storage column it starts at (it ends where the next begins)
   std::vector<S> dvx, dvy, dvz;      ///< per run (m/s)
+};
+
+/// What the device's patch stage (patch_state.h) reads besides the particles' tip displacement:
+/// the two windows (patch slot -> particle slots), the constants, and each patch slot's root
+/// height and cut flag, which change only when the window moves, a tuft is mown or the state is
+/// restored (`revision` then changes, and the device copies them again).
+template <class S>
+struct DevicePatchInputs {
+  LatticeWindow particles, patches;  ///< the particle window and the patch window (k times finer)
+  const PatchStateConstants<S>* constants = nullptr;
+  const std::vector<S>* rootY = nullptr;      ///< per patch slot (m)
+  const std::vector<uint8_t>* cut = nullptr;  ///< per patch slot: 1 where mown
+  uint64_t revision = 0;                      ///< changes whenever rootY or cut change
 };
 
 /// One device's copy of a world's particles (countX x countZ, storage order).
@@ -46,9 +61,28 @@ class ParticleDevice {
   /// levels), each way: the host's body stages push the grass under the bodies (world_device.cpp).
   virtual void downloadRows(ParticleArrays<S>& p, int64_t rowBegin, int64_t rowEnd) = 0;
   virtual void uploadRows(const ParticleArrays<S>& p, int64_t rowBegin, int64_t rowEnd) = 0;
+  /// Particles [first, first + count) of each span in storage order, everything of them (state,
+  /// anchors, trample levels), host to device: the cells a level-of-detail window move wrote.
+  struct Span {
+    int64_t first = 0, count = 0;
+  };
+  virtual void uploadCells(const ParticleArrays<S>& p, const std::vector<Span>& spans) = 0;
   /// Copies the device's particle state to the host, and the tip displacement of the last pass
   /// where dx, dy, dz are given.
   virtual void download(ParticleArrays<S>& p, std::vector<S>* dx, std::vector<S>* dy, std::vector<S>* dz) = 0;
+  /// The patch stage on the device, from the last pass's tip displacement: every patch slot's tip
+  /// offset, top and tilt level with the CPU's bits (PatchWriter::writeFast after updatePatchRow),
+  /// and a copy for drawing (patchDrawBuffer).
+  virtual void derivePatches(const DevicePatchInputs<S>& inputs) = 0;
+  /// Copies the last derivePatches' tip offsets, tops and tilt levels into `patches` (checks).
+  virtual void downloadPatches(PatchArrays<S>& patches) = 0;
+  /// A renderer sharing the device's context draws from this buffer (an OpenGL buffer name; 0
+  /// when the device has none): per patch slot four floats, top y, tip offset x, tip offset z (m,
+  /// each the double of its exact value rounded to float, as the host's scene extraction does)
+  /// and the brightness level (the tilt level, 3 where mown).
+  virtual uint32_t patchDrawBuffer() const = 0;
+  /// Host <-> device copies so far.
+  virtual DeviceTraffic traffic() const = 0;
 };
 
 /// Makes devices (one per world); implemented where a device API exists (sim/gpu/).

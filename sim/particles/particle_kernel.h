@@ -35,4 +35,10 @@ enum class PhysicsPath : uint8_t {
 /// "cpu", "gpu" or "gpu-readback".
 const char* physicsPathName(PhysicsPath path);
 
+/// Bytes copied between the host and a world's device since the device was made: the cost the
+/// GPU path's design keeps low (docs/gpu-physics.md) and `--hash-every` makes visible.
+struct DeviceTraffic {
+  int64_t toDevice = 0, toHost = 0;
+};
+
 }  // namespace sg

@@ -42,7 +42,10 @@ void World<S>::mowGrass() {
                      abs(local.z()) < shape.halfExtents.z();
           }
           if (!inside) continue;
-          if (patchWindow_.contains(i, j)) patches_.cut[patchWindow_.storageIndex(i, j)] = 1;
+          if (patchWindow_.contains(i, j)) {
+            patches_.cut[patchWindow_.storageIndex(i, j)] = 1;
+            ++patchInputsRevision_;
+          }
           cuts_.emplace(std::make_pair(i, j), uint8_t(1));
         }
     }

@@ -286,6 +286,7 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   // restored cuts), then the particles' dynamic state over it.
   deviceAhead_ = false;  // the restored state replaces a device's: uploaded before the next pass
   hostAhead_ = true;
+  deviceDisplacementCurrent_ = false;
   cuts_ = std::move(cuts);
   if (lodWindow_) fillWindow(originI, originJ, false);
   for (auto* v : {&particles_.px, &particles_.py, &particles_.pz, &particles_.vx, &particles_.vy, &particles_.vz})
@@ -313,6 +314,7 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
     std::fill(patches_.cut.begin(), patches_.cut.end(), uint8_t(0));
     for (const auto& [key, value] : cuts_) patches_.cut[patchWindow_.storageIndex(key.first, key.second)] = 1;
   }
+  ++patchInputsRevision_;
   tick_ = tick;
   failed_ = false;
   failure_ = SimError{};

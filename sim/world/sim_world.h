@@ -125,6 +125,13 @@ class SimWorld {
   /// (docs/gpu-physics.md).
   virtual std::string setPhysicsPath(PhysicsPath path, ParticleDeviceProvider* provider) = 0;
   virtual PhysicsPath physicsPath() const = 0;
+  /// Host <-> device copies of the world's current device so far (zero on the CPU path).
+  virtual DeviceTraffic deviceTraffic() const = 0;
+  /// The device's per-patch draw buffer (ParticleDevice::patchDrawBuffer, an OpenGL buffer name)
+  /// while it holds the patch state of the current tick, else 0 (the CPU path, gpu-readback, or a
+  /// state the host set since: a restore, a window move). A renderer in the device's context
+  /// draws the tuft tops from it; everything else about a tuft stays on the host.
+  virtual uint32_t devicePatchDrawBuffer() const = 0;
   /// The whole state as plain numbers (StateExport).
   virtual void exportState(StateExport& out) const = 0;
   /// Fills `out` (reusing its storage) with the current tips and body poses.

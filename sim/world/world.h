@@ -57,6 +57,18 @@ class World final : public SimWorld {
   ParticleKernel particleKernel() const override { return particleKernel_; }
   std::string setPhysicsPath(PhysicsPath path, ParticleDeviceProvider* provider) override;
   PhysicsPath physicsPath() const override { return physicsPath_; }
+  DeviceTraffic deviceTraffic() const override { return device_ ? device_->traffic() : DeviceTraffic{}; }
+  uint32_t devicePatchDrawBuffer() const override { return deriveDevicePatches() ? device_->patchDrawBuffer() : 0; }
+  /// The device's patch state of the current tick (derivePatches) into `out` (tests: it must
+  /// equal patches()); false when no device holds it (devicePatchDrawBuffer() == 0).
+  bool downloadDevicePatches(PatchArrays<S>* out) const;
+  /// The patches as the host holds them, without copying a device's state back: their roots,
+  /// rotations, variants and cut flags are always current, the tip offsets, tops and tilt levels
+  /// only while devicePatchDrawBuffer() is 0 (a renderer drawing the tops from the device).
+  const PatchArrays<S>& hostPatches() const { return patches_; }
+  /// The particles as the host holds them, without copying a device's state back: the anchors
+  /// are always current, the rest only while no device is ahead of the host.
+  const ParticleArrays<S>& hostParticles() const { return particles_; }
   void exportState(StateExport& out) const override;
   void observe(Observation& out) const override;
   int32_t bodyTemplate(int64_t body) const override;
@@ -70,6 +82,7 @@ class World final : public SimWorld {
   ParticleArrays<S>& mutableParticles() {  ///< tests: set up states
     syncFromDevice();
     hostAhead_ = true;
+    deviceDisplacementCurrent_ = false;
     return particles_;
   }
   const PatchArrays<S>& patches() const {
@@ -212,6 +225,18 @@ class World final : public SimWorld {
   std::vector<std::pair<int64_t, int64_t>> hostRowsAhead_;
   bool deviceAhead_ = false;
   bool hostAhead_ = false;
+  /// The device's tip displacements are the current state's (a pass on the `gpu` path since the
+  /// host last set the state or moved the window), and its patch stage ran on them. The patch
+  /// stage runs on the device only when a renderer asks for its buffer (deriveDevicePatches):
+  /// once per drawn frame, never in a headless run.
+  bool deviceDisplacementCurrent_ = false;
+  mutable bool devicePatchesCurrent_ = false;
+  /// Runs the device's patch stage if it has not run on the current state; false when the device
+  /// holds no current displacement to derive it from.
+  bool deriveDevicePatches() const;
+  /// Changes whenever a patch's root height or cut flag does (window moves, mowing, restores):
+  /// the device copies them again (DevicePatchInputs::revision).
+  uint64_t patchInputsRevision_ = 1;
 };
 
 }  // namespace sg

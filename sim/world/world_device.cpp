@@ -43,6 +43,7 @@ std::string World<S>::setPhysicsPath(PhysicsPath path, ParticleDeviceProvider* p
     device_ = std::move(device);
     physicsPath_ = path;
     hostAhead_ = true;  // uploaded before the next pass
+    deviceDisplacementCurrent_ = false;
     return "";
   } else {
     return "";  // unreachable: deviceLimitation() refused
@@ -99,6 +100,7 @@ bool World<S>::deviceParticlePass() {
     device_->download(particles_, nullptr, nullptr, nullptr);
     deviceAhead_ = false;
     hostAhead_ = true;
+    deviceDisplacementCurrent_ = false;
     return false;
   };
   if (pendingFixedFaults() != 0) return handBack();
@@ -106,11 +108,32 @@ bool World<S>::deviceParticlePass() {
   const RowFault fault = device_->advance(wind, particleConsts_, &faultBits);
   if (fault.particle >= 0) return handBack();
   deviceAhead_ = true;
+  deviceDisplacementCurrent_ = physicsPath_ == PhysicsPath::Gpu;
+  devicePatchesCurrent_ = false;
   if (physicsPath_ == PhysicsPath::GpuReadback) {
     // The thesis' design: the state comes back every tick, and the patch stage runs on the host.
     device_->download(particles_, &dispX_, &dispY_, &dispZ_);
     deviceAhead_ = false;
   }
+  return true;
+}
+
+template <class S>
+bool World<S>::deriveDevicePatches() const {
+  if (!device_ || !deviceDisplacementCurrent_) return false;
+  if (!devicePatchesCurrent_) {
+    device_->derivePatches(DevicePatchInputs<S>{grid_.window, patchWindow_, &patchConsts_, &patches_.rootY,
+                                                &patches_.cut, patchInputsRevision_});
+    devicePatchesCurrent_ = true;
+  }
+  return true;
+}
+
+template <class S>
+bool World<S>::downloadDevicePatches(PatchArrays<S>* out) const {
+  if (!deriveDevicePatches()) return false;
+  *out = patches_;  // the static fields (roots, rotations, variants, cuts) are the host's
+  device_->downloadPatches(*out);
   return true;
 }
 
@@ -156,6 +179,8 @@ void World<S>::syncFromDevice() const {
   template std::string World<S>::deviceLimitation() const;                             \
   template std::string World<S>::setPhysicsPath(PhysicsPath, ParticleDeviceProvider*); \
   template bool World<S>::deviceParticlePass();                                        \
+  template bool World<S>::downloadDevicePatches(PatchArrays<S>*) const;                \
+  template bool World<S>::deriveDevicePatches() const;                                 \
   template void World<S>::syncFromDevice() const;                                      \
   template void World<S>::bringPushedRowsToHost(const GrassPushers<S>&);               \
   template void World<S>::flushRowsToDevice();

@@ -175,8 +175,11 @@ template <class S>
 bool World<S>::patchStage() {
   // The patch stage is derived data only (never fed back into the state) and runs unchecked
   // arithmetic with Fixed's exact bits (patches/patch_state.h); like the window, its bits are
-  // cleared so they cannot be blamed on a later stage. With the particles on a device, the
-  // patches are derived when the host next reads them (syncFromDevice).
+  // cleared so they cannot be blamed on a later stage. With the particles on a device, the patch
+  // stage is derived where it is read, from the tip displacements the pass left there: on the
+  // device when a renderer in its context asks for its buffer (deriveDevicePatches, once per
+  // drawn frame), on the host when the host next reads the particles (syncFromDevice: copying
+  // the patches back would move more bytes than the displacement it derives them from).
   if (deviceAhead_) return true;
   updatePatchesFromDisplacement();
   takeFixedFaults();

@@ -15,6 +15,8 @@
 #include <cstdio>
 
 #include "replay/input_file.h"
+#include "replay/physics_devices.h"
+#include "sim/gpu/gl_physics.h"
 #include "viewer/app/text.h"
 
 // Sanitizer builds: the GL driver (Mesa's GLX and llvmpipe, LLVM) and libX11 keep allocations
@@ -101,6 +103,15 @@ bool App::open(std::string* error) {
     return false;
   }
   if (!live_->scenarioDir.empty()) renderer_->setAssetDirectory(live_->scenarioDir);
+  // GPU physics runs in this window's context (docs/gpu-physics.md): the renderer draws the
+  // tufts' tops straight from the device's buffers.
+  registerGpuPhysics(&gpu::makeCurrentContextPhysicsProvider);
+  if (const std::optional<PhysicsPath> path = parsePhysicsPath(opt_.physics); path && *path != PhysicsPath::Cpu) {
+    if (const std::string why = live_->setPhysics(*path); !why.empty()) {
+      *error = "--physics " + opt_.physics + ": " + why;
+      return false;
+    }
+  }
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   // The layout lives with the app's settings (settings.h), never next to the user's files; a
@@ -127,6 +138,7 @@ void App::close() {
     imgui_ = false;
   }
   renderer_.reset();  // GL objects go while the context is current
+  if (live_ && live_->world && window_) live_->world->setPhysicsPath(PhysicsPath::Cpu, nullptr);  // a device's too
   if (window_) glfwDestroyWindow(window_);
   window_ = nullptr;
   glfwTerminate();

@@ -131,6 +131,9 @@ class App {
   /// Applies scenario JSON edits by building a new Session (see docs/viewer.md: from tick 0, or
   /// replaying the inputs so far when `replayHistory`). On failure the old session keeps running.
   bool applyScenario(const std::string& text, bool replayHistory, const std::string& what);
+  /// Puts the (new) live session on `path`, the one the session it replaced ran on; an error
+  /// leaves it on the CPU and says so.
+  void keepPhysics(PhysicsPath path);
   void showError(const std::string& message);
   void resetEdits();
   std::string editedScenarioText() const;
@@ -156,6 +159,11 @@ class App {
   const Scenario& scenario() const { return play_ ? play_->scenario() : live_->scenario; }
 
   Options opt_;
+  // The stats panel's hash on the resident GPU path: computed on request (it copies the state
+  // back), kept for the world and tick it was taken at.
+  const SimWorld* hashedWorld_ = nullptr;
+  int64_t hashedTick_ = -1;
+  uint64_t hashedValue_ = 0;
   std::unique_ptr<Session> live_;
   std::unique_ptr<Playback> play_;
   CameraController cam_;

@@ -24,7 +24,9 @@ bool App::openFile(const std::string& path) {
         std::string e;
         if (!live_->stopRecording(&e)) showError(e);
       }
+      const PhysicsPath physics = live_->physics;
       live_ = std::move(s);
+      keepPhysics(physics);
       play_.reset();
       if (renderer_ && !live_->scenarioDir.empty()) renderer_->setAssetDirectory(live_->scenarioDir);
       status_ = "opened " + path;
@@ -149,7 +151,9 @@ bool App::applyScenario(const std::string& text, bool replayHistory, const std::
       showError(e);
   }
   play_.reset();
+  const PhysicsPath physics = live_->physics;
   live_ = std::move(next);
+  keepPhysics(physics);
   status_ = what + (replayHistory ? " (inputs so far replayed)" : " (new world from tick 0)") + note;
   std::printf("%s\n", status_.c_str());
   std::fflush(stdout);
@@ -159,6 +163,12 @@ bool App::applyScenario(const std::string& text, bool replayHistory, const std::
   if (selected_ >= live_->world->counts().bodies) selected_ = 0;
   resetEdits();
   return true;
+}
+
+void App::keepPhysics(PhysicsPath path) {
+  if (path == PhysicsPath::Cpu) return;
+  if (const std::string why = live_->setPhysics(path); !why.empty())
+    showError(std::string("physics ") + physicsPathName(path) + ": " + why + " (the new world runs on the CPU)");
 }
 
 }  // namespace sg::viewer

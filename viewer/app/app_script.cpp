@@ -88,6 +88,16 @@ int App::runCommand(const ScriptCommand& c) {
       if (play_) return bad("restart: expected a live session (a playback goes back with 'seek 0')");
       restartLive();
       return kGoOn;
+    case K::Physics: {
+      if (play_) return bad("physics: expected a live session (recordings play on the CPU in the viewer)");
+      const PhysicsPath path = PhysicsPath(c.count);
+      if (const std::string why = live_->setPhysics(path); !why.empty())
+        showError(std::string("physics ") + physicsPathName(path) + ": " + why);  // as the panel: the session goes on
+      else
+        status_ =
+            std::string("grass stages on ") + physicsPathName(path) + " from tick " + std::to_string(world().tick());
+      return kGoOn;
+    }
     case K::Camera:
       cam_.place(c.camera[0], c.camera[1], c.camera[2], c.camera[3], c.camera[4], ground());
       return kGoOn;

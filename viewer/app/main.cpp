@@ -5,8 +5,22 @@
 
 #include "replay/input_file.h"
 #include "replay/kernel_environment.h"
+#include "replay/physics_devices.h"
 #include "viewer/app/app.h"
 #include "viewer/app/keys.h"
+
+namespace {
+/// The GPU physics provider before the window exists: none. The viewer runs the device in its
+/// window's own context (App::open registers it), so a world asking earlier (a recording's
+/// `--ab-variant physics=gpu`) is told where the GPU path is.
+std::unique_ptr<sg::ParticleDeviceProvider> noDeviceBeforeTheWindow(std::string* error) {
+  *error =
+      "the viewer runs GPU physics for live scenarios (--physics gpu); recordings play on the CPU here "
+      "(`simgrass replay R.sgr --physics gpu --verify` and `simgrass compare R.sgr --variant physics=gpu` run them "
+      "on the device)";
+  return nullptr;
+}
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace sg;
@@ -43,6 +57,13 @@ int main(int argc, char** argv) {
   std::unique_ptr<Playback> playback;
   std::string startupError;
   const bool recording = !o.input.empty() && looksLikeRecording(o.input);
+  registerGpuPhysics(&noDeviceBeforeTheWindow);
+  if (recording && o.physics != "cpu") {
+    std::string why;
+    noDeviceBeforeTheWindow(&why);
+    std::fprintf(stderr, "simgrass-viewer: --physics %s: %s\n", o.physics.c_str(), why.c_str());
+    return kExitBadInput;
+  }
   try {
     if (recording && !o.record.empty())
       throw std::invalid_argument("--record: expected a scenario to record, got the recording '" + o.input + "'");

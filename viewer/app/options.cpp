@@ -41,6 +41,11 @@ int parseOptions(int argc, char** argv, Options* o) {
   app.add_flag("--keep-open-on-error", o->keepOpenOnError,
                "A bad input file opens the window anyway (built-in meadow) and shows the error there");
   app.add_option("--threads", o->threads, "Simulation worker threads")->check(CLI::Range(1, 256));
+  app.add_option("--physics", o->physics,
+                 "Where a live scenario's grass stages run: cpu, gpu (compute shaders in the window's context; "
+                 "the tufts are drawn from the device's buffers, nothing copied back) or gpu-readback "
+                 "(docs/gpu-physics.md)")
+      ->check(CLI::IsMember({"cpu", "gpu", "gpu-readback"}));
   app.add_option("--config-dir", o->configDir,
                  "Folder of the settings kept between runs (viewer.json, imgui.ini); default "
                  "$XDG_CONFIG_HOME/simgrass or ~/.config/simgrass, none for --script runs");

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "replay/physics_devices.h"
 #include "viewer/app/app.h"
 #include "viewer/app/keys.h"
 #include "viewer/app/text.h"
@@ -70,7 +71,16 @@ void App::panelStats() {
     for (size_t st = 0; st < size_t(Stage::Count); ++st)
       if (stageIsTimed(Stage(st))) ImGui::Text("  %-22s %.3f ms", timedStageName(Stage(st)), stageMs_[st]);
   }
-  ImGui::Text("hash %s", hex(world().stateHash()).c_str());
+  // On the resident GPU path a hash copies the state back: on request, not every frame.
+  if (world().physicsPath() != PhysicsPath::Gpu) {
+    ImGui::Text("hash %s", hex(world().stateHash()).c_str());
+  } else if (hashedWorld_ == &world() && hashedTick_ == world().tick()) {
+    ImGui::Text("hash %s", hex(hashedValue_).c_str());
+  } else if (ImGui::Button("Hash (copies the state back)")) {
+    hashedWorld_ = &world();
+    hashedTick_ = world().tick();
+    hashedValue_ = world().stateHash();
+  }
 }
 
 void App::panelOpen() {
@@ -300,6 +310,22 @@ void App::panelCamera() {
 
 void App::panelPhysics() {
   if (ImGui::CollapsingHeader("Physics")) {
+    // Where the grass stages run (docs/gpu-physics.md): switching keeps the state bit for bit.
+    static constexpr const char* kPaths[] = {"cpu", "gpu", "gpu-readback"};
+    int path = int(live_->physics);
+    if (ImGui::Combo("runs on", &path, kPaths, 3) && path != int(live_->physics)) {
+      if (const std::string why = live_->setPhysics(PhysicsPath(path)); !why.empty())
+        showError(std::string("physics ") + kPaths[path] + ": " + why);
+      else
+        status_ = std::string("grass stages on ") + kPaths[path] + " from tick " + std::to_string(world().tick());
+    }
+    ImGui::TextWrapped("%s", describePhysics(world()).c_str());
+    if (world().physicsPath() != PhysicsPath::Cpu) {
+      const DeviceTraffic t = world().deviceTraffic();
+      ImGui::Text("copied back %.2f MB, up %.2f MB", double(t.toHost) / 1e6, double(t.toDevice) / 1e6);
+      ImGui::TextDisabled(world().devicePatchDrawBuffer() ? "tufts drawn from the device's buffer"
+                                                          : "tufts drawn from the host's patches");
+    }
     ImGui::SliderFloat("gust strength x", &edits_.gustScale, 0.0f, 4.0f);
     ImGui::SliderFloat("gust period x", &edits_.gustPeriodScale, 0.25f, 4.0f);
     // The grass model: switching takes the new model's damping and acceleration (as the

@@ -161,6 +161,11 @@ bool parseScript(const std::string& text, const std::string& file, std::vector<S
       if (w.size() != 2 || (w[1] != "side" && w[1] != "overlay"))
         return fail("expected 'ab side' or 'ab overlay', got '" + shown + "'");
       c.count = w[1] == "overlay";
+    } else if (cmd == "physics") {
+      c.kind = ScriptCommand::Kind::Physics;
+      if (w.size() != 2 || (w[1] != "cpu" && w[1] != "gpu" && w[1] != "gpu-readback"))
+        return fail("expected 'physics cpu', 'physics gpu' or 'physics gpu-readback', got '" + shown + "'");
+      c.count = w[1] == "cpu" ? 0 : w[1] == "gpu" ? 1 : 2;
     } else if (cmd == "lod") {
       c.kind = ScriptCommand::Kind::Lod;
       if (w.size() != 2 || (w[1] != "on" && w[1] != "off"))
@@ -182,7 +187,7 @@ bool parseScript(const std::string& text, const std::string& file, std::vector<S
     } else {
       return fail("unknown command '" + shown +
                   "' (expected frames, key, tap, mouse, button, camera, select, record, screenshot, quit, play, "
-                  "pause, step, back, restart, seek, speed, ab, open, set, regenerate, lod, print or status)");
+                  "pause, step, back, restart, seek, speed, ab, open, set, regenerate, lod, physics, print or status)");
     }
     out->push_back(c);
   }

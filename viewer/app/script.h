@@ -39,6 +39,7 @@ struct ScriptCommand {
     Button,   ///< button left|right down|up
     Back,     ///< back N: step N ticks back (live: through the history; playback: seek)
     Restart,  ///< restart: the live session back to tick 0 (Home)
+    Physics,  ///< physics cpu|gpu|gpu-readback: where the live world's grass stages run (count: PhysicsPath)
   } kind = Kind::Quit;
   int64_t count = 0;  ///< frames N; select N; step N; seek T; lod 1|0; ab 0 (side) | 1 (overlay)
   double number = 0;  ///< speed X

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "replay/input_file.h"
+#include "replay/physics_devices.h"
 #include "replay/scenario_files.h"
 #include "viewer/app/text.h"
 
@@ -121,7 +122,7 @@ bool Session::seek(int64_t t, bool* stopped, std::string* error) {
   if (!(world->tick() <= t && world->tick() >= from)) {
     try {
       if (snap == snapshots_.rend())
-        world = makeWorld(scenario, threads, physicalMemoryBytes());
+        world = makeSessionWorld();
       else
         world->restoreState(snap->second);
     } catch (const std::exception& e) {
@@ -139,13 +140,27 @@ bool Session::seek(int64_t t, bool* stopped, std::string* error) {
   return true;
 }
 
+std::unique_ptr<SimWorld> Session::makeSessionWorld() const {
+  std::unique_ptr<SimWorld> w = makeWorld(scenario, threads, physicalMemoryBytes());
+  if (physics != PhysicsPath::Cpu)
+    if (const std::string why = applyPhysicsPath(*w, physics); !why.empty())
+      throw std::runtime_error(std::string("--physics ") + physicsPathName(physics) + ": " + why);
+  return w;
+}
+
+std::string Session::setPhysics(PhysicsPath path) {
+  if (std::string why = applyPhysicsPath(*world, path); !why.empty()) return why;
+  physics = path;
+  return "";
+}
+
 bool Session::startRecording(const std::string& path, std::string* error) {
   if (recorder) {
     *error = "already recording to " + recordPath;
     return false;
   }
   try {
-    std::unique_ptr<SimWorld> fresh = makeWorld(scenario, threads, physicalMemoryBytes());
+    std::unique_ptr<SimWorld> fresh = makeSessionWorld();  // it becomes the live world
     RecordSettings settings;
     settings.checkEvery = defaultCheckEvery(fresh->counts().patches());
     auto rec = std::make_unique<Recorder>(path, scenario, files, *fresh, settings);

@@ -25,6 +25,14 @@ class Session {
   std::string recordPath;
   int threads = 1;
   StageClock clock;
+  /// Where the grass stages of this session's worlds run (docs/gpu-physics.md): the live world
+  /// and every world the session makes later (a seek from tick 0, a recording's catch-up).
+  PhysicsPath physics = PhysicsPath::Cpu;
+
+  /// Moves the live world, and every later one, to `path`: "" on success, else why not (one
+  /// line; the session unchanged). The GPU paths need the process's provider (the viewer
+  /// registers its window's context once GL is up).
+  std::string setPhysics(PhysicsPath path);
 
   /// Loads a scenario file (empty: the built-in meadow) and builds its world. Throws ScenarioError.
   static std::unique_ptr<Session> load(const std::string& path, int threads);
@@ -57,6 +65,9 @@ class Session {
   size_t snapshotCount() const { return snapshots_.size(); }
   static constexpr uint64_t kLiveSnapshotBytes = uint64_t(256) << 20;
   std::string recordingError;  ///< set by step() when the recording stopped on a write error
+  /// A world of the scenario at tick 0 on the session's physics path. Throws std::runtime_error
+  /// when the device refuses it.
+  std::unique_ptr<SimWorld> makeSessionWorld() const;
 
   /// Records the whole session, from tick 0, to `path`: a fresh world replays the inputs so far
   /// under a Recorder (a recording must start from a state a replay can build), must reach the

@@ -21,9 +21,11 @@
 #include "replay/format/sgr_format.h"
 #include "replay/format/sgr_reader.h"
 #include "replay/input_file.h"
+#include "replay/physics_devices.h"
 #include "replay/player.h"
 #include "replay/progress.h"
 #include "replay/scenario_files.h"
+#include "sim/gpu/gl_physics.h"
 #include "sim/scenario/json_bounds.h"
 #include "viewer/offscreen/osmesa_context.h"
 #include "viewer/render/scene.h"
@@ -34,6 +36,7 @@ namespace fs = std::filesystem;
 
 struct RenderOptions {
   std::string input, output, ticks = "0", size = "800x600", camera, contactSheet, video, debug;
+  std::string physics = "cpu";
   int msaa = 4;
   int threads = 1;
   bool json = false;
@@ -292,6 +295,9 @@ int render(const RenderOptions& o) {
   for (const std::string* out : {&o.contactSheet, &o.video})
     if (!out->empty() && sameFile(*out, o.input))
       return fail(kExitBadInput, *out + ": expected an output file other than the input " + o.input);
+  const std::optional<PhysicsPath> physics = parsePhysicsPath(o.physics);
+  if (!physics)
+    return fail(kExitBadInput, "--physics: expected cpu, gpu or gpu-readback, got '" + shown(o.physics) + "'");
   viewer::DebugFlags debug;
   std::string badItem;
   if (!parseDebugList(o.debug, &debug, &badItem))
@@ -376,6 +382,13 @@ int render(const RenderOptions& o) {
   std::unique_ptr<viewer::OffscreenRenderer> renderer =
       viewer::OffscreenRenderer::create(width, height, o.msaa, &error);
   if (!renderer) return fail(kExitMismatch, error);
+  if (*physics != PhysicsPath::Cpu) {
+    // The device in the renderer's own context, so the frames draw the tufts' tops straight from
+    // its buffers (docs/gpu-physics.md): nothing is copied back to draw a frame.
+    registerGpuPhysics(&gpu::makeCurrentContextPhysicsProvider);
+    if (const std::string why = applyPhysicsPath(world, *physics); !why.empty())
+      return fail(kExitBadInput, "--physics " + o.physics + ": " + why);
+  }
   renderer->options().ssao = o.ssao;
   renderer->options().alphaToCoverage = !o.alphaTest;
   renderer->options().rockBlend = !o.noRock;
@@ -496,6 +509,9 @@ int render(const RenderOptions& o) {
     j["rockBlend"] = !o.noRock;
     j["debug"] = o.debug;
     j["renderer"] = gl;
+    j["physics"] = describePhysics(world);
+    j["deviceBytesToHost"] = world.deviceTraffic().toHost;
+    j["deviceBytesToDevice"] = world.deviceTraffic().toDevice;
     j["tufts"] = renderer->scene().tufts.size();
     j["medianSimulationMsPerTick"] = median(simMsPerTick);
     j["medianExtractMs"] = median(extractMs);
@@ -508,6 +524,9 @@ int render(const RenderOptions& o) {
     std::printf("rendered   %zu frame%s of %s, %dx%d, msaa %d, to %s\n", files.size(), files.size() == 1 ? "" : "s",
                 scenario.name.c_str(), width, height, renderer->samples(), o.output.c_str());
     std::printf("renderer   %s\n", gl.c_str());
+    if (*physics != PhysicsPath::Cpu)
+      std::printf("physics    %s; %" PRId64 " bytes copied back\n", describePhysics(world).c_str(),
+                  world.deviceTraffic().toHost);
     std::printf("time       median %.1f ms/frame rendering (%zu tufts), %.1f ms extracting, %.3f ms/tick simulating\n",
                 median(renderMs), renderer->scene().tufts.size(), median(extractMs), median(simMsPerTick));
     if (!o.contactSheet.empty()) std::printf("sheet      %s\n", o.contactSheet.c_str());
@@ -542,6 +561,9 @@ void addRenderCommand(CLI::App& app, int* exitCode) {
   cmd->add_option("--video", o->video,
                   "Also encode the frames with ffmpeg (skipped with a note when ffmpeg is missing)");
   cmd->add_option("--threads", o->threads, "Simulation worker threads")->check(CLI::Range(1, 256));
+  cmd->add_option("--physics", o->physics,
+                  "Where the grass stages run: cpu, gpu (in the renderer's context: the frames draw the tops "
+                  "from the device, nothing copied back) or gpu-readback (docs/gpu-physics.md)");
   cmd->add_flag("--json", o->json, "Machine-readable output");
   cmd->footer("Exit codes: 0 ok, 1 simulation fault or no OpenGL context, 2 bad input.");
   cmd->callback([o, exitCode] { *exitCode = render(*o); });

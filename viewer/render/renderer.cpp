@@ -376,6 +376,32 @@ struct Renderer::Impl {
   GLuint captureProgram = 0;  ///< the tuft vertex shader with transform feedback of vWorld
   GLuint tuftVao = 0, tuftBuffer = 0, emptyVao = 0, debugVao = 0, debugBuffer = 0;
   size_t tuftCapacity = 0;
+  // The GPU physics path: per drawn tuft its slot in the device's patch buffer (attribute 3),
+  // and that buffer seen as a buffer texture (Scene::deviceTops).
+  GLuint slotBuffer = 0, deviceTopTexture = 0;
+  std::vector<GLint> slots;
+
+  /// Binds the device's tops (or none) for the tuft programs' next draws of instances whose
+  /// slots are `slots` (unit 5: the atlas, heights, AO and rock use lower ones).
+  void bindDeviceTops(const Scene& scene) {
+    glBindVertexArray(tuftVao);
+    if (scene.deviceTops == 0) {
+      glDisableVertexAttribArray(3);
+      return;
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, slotBuffer);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(slots.size() * sizeof(GLint)), slots.data(), GL_STREAM_DRAW);
+    glEnableVertexAttribArray(3);
+    glActiveTexture(GL_TEXTURE0 + kDeviceTopsUnit);
+    glBindTexture(GL_TEXTURE_BUFFER, deviceTopTexture);
+    glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, scene.deviceTops);
+    glActiveTexture(GL_TEXTURE0);
+  }
+  void deviceTopUniforms(GLuint p, const Scene& scene) const {
+    glUniform1i(loc(p, "uDeviceTops"), scene.deviceTops != 0 ? 1 : 0);
+    glUniform1i(loc(p, "uTops"), kDeviceTopsUnit);
+  }
+  static constexpr GLint kDeviceTopsUnit = 5;
   Mesh sphere, cube, ground;
   uint64_t groundRevision = 0;
   // The terrain under the tufts: the ground grid's inner heights as a float texture.
@@ -542,8 +568,9 @@ struct Renderer::Impl {
     for (GLuint p : {tuftProgram, groundProgram, bodyProgram, skyProgram, prepassGround, prepassBody, prepassTuft,
                      ssaoProgram, blurProgram, debugProgram, captureProgram})
       if (p) glDeleteProgram(p);
-    for (GLuint* b : {&tuftBuffer, &debugBuffer})
+    for (GLuint* b : {&tuftBuffer, &debugBuffer, &slotBuffer})
       if (*b) glDeleteBuffers(1, b);
+    if (deviceTopTexture) glDeleteTextures(1, &deviceTopTexture);
     for (GLuint* a : {&tuftVao, &emptyVao, &debugVao})
       if (*a) glDeleteVertexArrays(1, a);
     sphere.release();
@@ -596,6 +623,11 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
   glVertexAttribPointer(2, 4, GL_UNSIGNED_BYTE, GL_FALSE, stride,  // variant, level, heat, trail
                         reinterpret_cast<const void*>(offsetof(TuftInstance, variant)));
   glVertexAttribDivisor(2, 2);
+  glGenBuffers(1, &r.slotBuffer);
+  glGenTextures(1, &r.deviceTopTexture);
+  glBindBuffer(GL_ARRAY_BUFFER, r.slotBuffer);
+  glVertexAttribIPointer(3, 1, GL_INT, sizeof(GLint), nullptr);
+  glVertexAttribDivisor(3, 2);
   glBindVertexArray(0);
   sphereMesh(&r.sphere);
   cubeMesh(&r.cube);
@@ -626,9 +658,13 @@ std::vector<std::array<float, 3>> Renderer::captureTuftCorners(const Scene& scen
   glBindBuffer(GL_ARRAY_BUFFER, r.tuftBuffer);
   glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(n * sizeof(TuftInstance)), scene.tufts.data(), GL_STREAM_DRAW);
   r.tuftCapacity = n;
+  r.slots.resize(n);  // in scene order
+  for (size_t i = 0; i < n; ++i) r.slots[i] = i < scene.simulatedTufts ? GLint(i) : -1;
+  r.bindDeviceTops(scene);
   GLuint p = r.captureProgram;
   glUseProgram(p);
   r.heightUniforms(p);
+  r.deviceTopUniforms(p, scene);
   glUniform1f(loc(p, "uTrailFlatten"), lighting_.trailFlatten);
   glUniform1f(loc(p, "uCrossWidth"), lighting_.crossWidth);
   glUniform1f(loc(p, "uVariation"), lighting_.colourVariation);
@@ -747,9 +783,13 @@ void Renderer::draw(const Scene& scene, const Camera& camera, int width, int hei
     if (options.cull) {
       // A sphere around both quads: centred half way up, reaching the tip-shifted top corners;
       // plus one half width for the terrain lift of the bottom corners (slopes up to 45 degrees).
-      const float h = std::fabs(t.topY - t.y), tip = std::sqrt(t.tipX * t.tipX + t.tipZ * t.tipZ);
+      // A tuft whose top is on the device (no copy back) stands straight here, its tip anywhere
+      // within deviceTipReach of the root (the rod keeps it there).
+      const bool onDevice = scene.deviceTops != 0 && i < scene.simulatedTufts;
+      const float h = std::fabs(t.topY - t.y);
+      const float tip = onDevice ? scene.deviceTipReach : std::sqrt(t.tipX * t.tipX + t.tipZ * t.tipZ);
       const float cx = t.x + 0.5f * t.tipX, cy = t.y + 0.5f * h, cz = t.z + 0.5f * t.tipZ;
-      const float across = t.halfWidth + 0.5f * tip, up = 0.5f * h + t.halfWidth;
+      const float across = t.halfWidth + (onDevice ? tip : 0.5f * tip), up = 0.5f * h + t.halfWidth;
       const float radius = std::sqrt(across * across + up * up);
       const float ex = cx - camera.x, ey = cy - camera.y, ez = cz - camera.z;
       if (std::sqrt(ex * ex + ey * ey + ez * ez) - radius > cullDistance) {
@@ -771,6 +811,11 @@ void Renderer::draw(const Scene& scene, const Camera& camera, int width, int hei
   if (n > 0) {
     r.sorted.resize(n);
     for (size_t i = 0; i < n; ++i) r.sorted[i] = scene.tufts[r.order[i].second];
+    if (scene.deviceTops != 0) {
+      r.slots.resize(n);
+      for (size_t i = 0; i < n; ++i)
+        r.slots[i] = r.order[i].second < scene.simulatedTufts ? GLint(r.order[i].second) : -1;
+    }
     glBindVertexArray(r.tuftVao);
     glBindBuffer(GL_ARRAY_BUFFER, r.tuftBuffer);
     const size_t bytes = n * sizeof(TuftInstance);
@@ -780,6 +825,7 @@ void Renderer::draw(const Scene& scene, const Camera& camera, int width, int hei
     } else {
       glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(bytes), r.sorted.data());
     }
+    r.bindDeviceTops(scene);
   }
   r.stats.cullAndSortMs =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cullStart).count();
@@ -792,6 +838,7 @@ void Renderer::draw(const Scene& scene, const Camera& camera, int width, int hei
     }
   auto tuftUniforms = [&](GLuint p) {
     r.heightUniforms(p);
+    r.deviceTopUniforms(p, scene);
     glUniform1f(loc(p, "uTrailFlatten"), L.trailFlatten);
     glUniform1f(loc(p, "uTrailDarken"), L.trailDarken);
     glUniform1f(loc(p, "uCrossWidth"), L.crossWidth);

@@ -410,8 +410,13 @@ void extractTyped(const World<S>& w, const Scenario& scenario, Scene* scene) {
   const float scaleY = float(scenario.field.scaleY.toDouble());
   scene->tuftHeight = scaleY;
 
-  // Simulated tufts: every storage slot of the patch window holds one patch.
-  const PatchArrays<S>& p = w.patches();
+  // Simulated tufts: every storage slot of the patch window holds one patch. On the GPU path
+  // the device holds the tops (the renderer draws them from its buffer); the roots, rotations
+  // and variants are the host's, and nothing is copied back.
+  scene->deviceTops = w.devicePatchDrawBuffer();
+  scene->deviceTipReach = scene->deviceTops ? float(toD(w.particleConstants().rodLength)) : 0.0f;
+  const bool onDevice = scene->deviceTops != 0;
+  const PatchArrays<S>& p = onDevice ? w.hostPatches() : w.patches();
   const LatticeWindow& win = w.patchWindow();
   const size_t n = size_t(win.size());
   scene->tufts.resize(n);
@@ -421,12 +426,18 @@ void extractTyped(const World<S>& w, const Scenario& scenario, Scene* scene) {
     t.y = float(toD(p.rootY[k]));
     t.z = float(toD(p.rootZ[k]));
     t.halfWidth = halfWidth;
-    t.topY = float(toD(p.topY[k]));
-    t.tipX = float(toD(p.tipOffsetX[k]));
-    t.tipZ = float(toD(p.tipOffsetZ[k]));
+    if (onDevice) {  // placeholders: a tuft standing straight
+      t.topY = t.y + scaleY;
+      t.tipX = t.tipZ = 0;
+      t.level = 0;
+    } else {
+      t.topY = float(toD(p.topY[k]));
+      t.tipX = float(toD(p.tipOffsetX[k]));
+      t.tipZ = float(toD(p.tipOffsetZ[k]));
+      t.level = p.cut[k] ? uint8_t(3) : p.tiltLevel[k];  // thesis §5: mown tufts stay brighter
+    }
     t.angle = float(p.rotation[k]) * kTurn;
     t.variant = p.variant[k];
-    t.level = p.cut[k] ? uint8_t(3) : p.tiltLevel[k];  // thesis §5: mown tufts stay brighter
     t.heat = 0;
     t.trail = 0;
   }
@@ -492,9 +503,10 @@ void extractTyped(const World<S>& w, const Scenario& scenario, Scene* scene) {
   // Trails: where bodies pressed the grass (render-side memory), and the blade model's trampling.
   updateTrails(w, scenario, scaleY, scene);
   const TrailMemory& mem = scene->trails;
-  const ParticleArrays<S>& pa = w.particles();
+  // (Trample levels are particle state: on the device they would have to be copied back.)
+  const ParticleArrays<S>& pa = onDevice ? w.hostParticles() : w.particles();
   const ParticleGrid& grid = w.particleGrid();
-  const bool trampling = !pa.trample.empty();
+  const bool trampling = !onDevice && !pa.trample.empty();
   if (!mem.fadesAt.empty() || trampling) {
     for (size_t k = 0; k < n; ++k) {
       const int64_t i = win.latticeColumn(int64_t(k) % win.sizeI), j = win.latticeRow(int64_t(k) / win.sizeI);

@@ -126,6 +126,13 @@ struct Scene {
   float tuftHeight = 1;           ///< scaleY
   TrailMemory trails;             ///< where bodies pressed the grass (kept between extractions)
   RingCache ring;                 ///< the edge ring's tufts (kept between extractions)
+  /// The GPU physics path (docs/gpu-physics.md): an OpenGL buffer of the device, in the
+  /// renderer's context, holding each simulated tuft's top y, tip offset x and z and brightness
+  /// level (SimWorld::devicePatchDrawBuffer); 0: the tufts hold their own. With a buffer, the
+  /// simulated tufts' topY, tipX, tipZ and level are placeholders the renderer replaces (no copy
+  /// back), and its culling allows each tip `deviceTipReach` metres from the root.
+  uint32_t deviceTops = 0;
+  float deviceTipReach = 0;
 };
 
 /// Fills `scene` from the world's current state. The ground grid is rebuilt only when `scene`
@@ -141,6 +148,10 @@ struct Scene {
 /// kTrailSweepTicks and kTrailSweepMetres apart); a pressed patch's TuftInstance::trail fades
 /// from 255 to 0 over kTrailSeconds. With the blade model's trampling, a trampled particle's
 /// level shows too. An extraction at an earlier tick or of another scenario starts afresh.
+///
+/// A world whose device holds the current patch state (SimWorld::devicePatchDrawBuffer) is
+/// extracted without copying anything back: Scene::deviceTops names the device's buffer (the
+/// renderer must share the device's context), and trampled blades show no trample level.
 void extractScene(const SimWorld& world, const Scenario& scenario, Scene* scene);
 
 /// Which debug overlay layers to build / draw.

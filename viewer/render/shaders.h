@@ -79,6 +79,12 @@ inline constexpr const char* kTuftVertex = R"GLSL(
 layout(location = 0) in vec4 aRoot;  // root x, y, z; half width
 layout(location = 1) in vec4 aTop;   // top y; tip offset x, z; angle (rad)
 layout(location = 2) in vec4 aTile;  // atlas variant, brightness level, divergence heat 0..255, trail 0..255
+// The GPU physics path (docs/gpu-physics.md): the tuft's slot in uTops, the device's patch buffer,
+// which then holds its top y, tip offset x and z and brightness level (aTop.xyz and aTile.y are
+// placeholders); -1: the tuft's own values (the edge ring).
+layout(location = 3) in int aSlot;
+uniform bool uDeviceTops;
+uniform samplerBuffer uTops;
 uniform mat4 uViewProj;
 uniform vec4 uTiles[68];             // (variants + 1) * levels tile rects: u0, v0 (top), u1, v1
 uniform int uLevels;
@@ -113,6 +119,12 @@ float terrainAt(vec2 xz) {
                           : h11 + (1.0 - f.x) * (h01 - h11) + (1.0 - f.y) * (h10 - h11);
 }
 void main() {
+  vec4 top4 = aTop, tile4 = aTile;
+  if (uDeviceTops && aSlot >= 0) {
+    vec4 d = texelFetch(uTops, aSlot);
+    top4.xyz = d.xyz;
+    tile4.y = d.w;
+  }
   // Two instances per tuft (the attributes advance every second instance): the crossed quads,
   // the second turned 90 degrees and showing the tile mirrored, each uCrossWidth as wide as the
   // thesis' quad. Each is a triangle strip 0..3: bottom-left, bottom-right, top-left, top-right
@@ -121,27 +133,27 @@ void main() {
   int corner = gl_VertexID;
   float side = (corner & 1) == 0 ? -1.0 : 1.0;
   bool top = corner >= 2;
-  float angle = aTop.w + (quad == 1 ? 1.5707963 : 0.0);
+  float angle = top4.w + (quad == 1 ? 1.5707963 : 0.0);
   vec3 along = vec3(cos(angle), 0.0, -sin(angle)) * aRoot.w * uCrossWidth;
   vec3 p = aRoot.xyz + side * along;
   // Terrain-following: each bottom corner lies as far above the terrain under it as the root does
   // above its own, and the top edge keeps the tuft's height above it (the blades grow up from the
   // slope). Without a ground grid (synthetic scenes), the flat quad.
   float lift = uHasHeights ? terrainAt(p.xz) - terrainAt(aRoot.xz) : 0.0;
-  float trail = aTile.w / 255.0;
-  if (top) p = vec3(p.x + aTop.y, aRoot.y + (aTop.x - aRoot.y) * (1.0 - uTrailFlatten * trail), p.z + aTop.z);
+  float trail = tile4.w / 255.0;
+  if (top) p = vec3(p.x + top4.y, aRoot.y + (top4.x - aRoot.y) * (1.0 - uTrailFlatten * trail), p.z + top4.z);
   p.y += lift;
-  vec4 tile = uTiles[int(aTile.x + 0.5) * uLevels + int(aTile.y + 0.5)];
+  vec4 tile = uTiles[int(tile4.x + 0.5) * uLevels + int(tile4.y + 0.5)];
   bool left = (side < 0.0) != (quad == 1);
   vUv = vec2(left ? tile.x : tile.z, top ? tile.y : tile.w);
   vUp = top ? 1.0 : 0.0;
-  vHeat = aTile.z / 255.0;
+  vHeat = tile4.z / 255.0;
   // Per vertex, as all of it is linear along the quad or constant over it (the fragment shader is
   // what llvmpipe pays for, twice per tuft): darker toward the root, a stand-in for the thesis'
   // SSAO (the lower part of a tuft sits in the others' shade); a pressed tuft (a body's trail)
   // darker, its blades lying in each other's shade; fog over at most a metre of quad.
   // (Painted marking tufts keep their white: paint does not vary with the meadow.)
-  vec3 tint = int(aTile.x + 0.5) == uMarkingVariant ? vec3(1.0) : meadowTint(aRoot.xz);
+  vec3 tint = int(tile4.x + 0.5) == uMarkingVariant ? vec3(1.0) : meadowTint(aRoot.xz);
   vShade = tint * (top ? 1.0 : 0.42) * (1.0 - uTrailDarken * trail);
   float d = distance(p, uCameraPos) * uFogDensity;
   vFog = exp(-d * d);
