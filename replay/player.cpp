@@ -92,6 +92,14 @@ Player::Player(const sgr::Recording& recording, int threads, const VariantSettin
 
 void Player::restart() { buildWorld(); }
 
+std::string Player::setPhysics(PhysicsPath path) {
+  if (path != PhysicsPath::Cpu && scenario_.scalar == ScalarKind::Float && sameSettings_)
+    return "a float recording's hashes promise bits the device's float does not keep: it plays on the CPU";
+  if (std::string why = applyPhysicsPath(*world_, path); !why.empty()) return why;
+  physics_ = path;
+  return "";
+}
+
 void Player::buildWorld() {
   world_ = makeWorldWithinMemory(scenario_, threads_);
   if (physics_ && *physics_ != PhysicsPath::Cpu)

@@ -57,6 +57,10 @@ class Player {
   /// also decompressed (and, under the recorded settings, compared byte for byte with the replayed
   /// state). Throws sgr::RecordingError for a damaged snapshot.
   VerifyReport verify(const std::function<void(int64_t)>& progress = {});
+  /// Moves the world, and every world this player builds later, to `path`: "" on success, else
+  /// why not (one line; the player unchanged). A float recording stays on the CPU: its hashes are
+  /// a promise about bits the device's float does not keep (docs/gpu-physics.md).
+  std::string setPhysics(PhysicsPath path);
 
  private:
   void restart();

@@ -263,8 +263,8 @@ TEST(GpuPhysics, RenderDrawsTheDevicesTopsWithoutCopyingThemBack) {
 
 /// The viewer runs the device in its window's GLX context (`--physics gpu`, the script's and the
 /// Physics panel's `physics`), switches paths mid-run with the state carried over, and draws the
-/// tufts from the device's buffer: the same pixels and hashes as a CPU session. A recording with
-/// `--physics gpu` is refused in one line before any window.
+/// tufts from the device's buffer: the same pixels and hashes as a CPU session. A recording plays
+/// there with every recorded hash matching.
 TEST(GpuPhysics, TheViewerDrawsFromTheDeviceInItsOwnContext) {
   TempDir dir;
   const std::string scenario = quote(test::sourcePath("scenarios/wind-fronts.json"));
@@ -291,10 +291,13 @@ TEST(GpuPhysics, TheViewerDrawsFromTheDeviceInItsOwnContext) {
   const std::vector<uint8_t> a = readBytes(dir.file("cpu.png")), b = readBytes(dir.file("gpu.png"));
   ASSERT_FALSE(a.empty());
   EXPECT_TRUE(a == b) << "the frame drawn from the device differs from the CPU's";
-  const CliResult refused = viewer_test::runViewer(
-      quote(test::sourcePath("scenarios/recordings/thesis-meadow-fx32.sgr")) + " --physics gpu", false);
-  EXPECT_EQ(refused.exitCode, 2) << refused.describe();
-  EXPECT_TRUE(isOneLine(refused.err));
+  // A recording plays on the device too, every recorded hash checked as it plays.
+  dir.write("play.txt", "play\nframes 30\npause\nprint\nquit\n");
+  const CliResult play = viewer_test::runViewer(quote(test::sourcePath("scenarios/recordings/thesis-meadow-fx32.sgr")) +
+                                                " --physics gpu --script " + quote(dir.file("play.txt")) + window);
+  ASSERT_EQ(play.exitCode, 0) << play.describe();
+  EXPECT_NE(play.out.find("mismatch -1"), std::string::npos) << play.out;
+  EXPECT_EQ(play.out.find("hashes ok 0,"), std::string::npos) << play.out;
 }
 
 /// `sweep --physics cpu,gpu`: each fx32 row gets a device twin with the same errors (the same

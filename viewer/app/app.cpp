@@ -107,7 +107,8 @@ bool App::open(std::string* error) {
   // tufts' tops straight from the device's buffers.
   registerGpuPhysics(&gpu::makeCurrentContextPhysicsProvider);
   if (const std::optional<PhysicsPath> path = parsePhysicsPath(opt_.physics); path && *path != PhysicsPath::Cpu) {
-    if (const std::string why = live_->setPhysics(*path); !why.empty()) {
+    live_->physics = *path;  // a recording opened later plays there too (App::openFile)
+    if (const std::string why = play_ ? play_->setPhysics(*path) : live_->setPhysics(*path); !why.empty()) {
       *error = "--physics " + opt_.physics + ": " + why;
       return false;
     }
@@ -138,7 +139,10 @@ void App::close() {
     imgui_ = false;
   }
   renderer_.reset();  // GL objects go while the context is current
-  if (live_ && live_->world && window_) live_->world->setPhysicsPath(PhysicsPath::Cpu, nullptr);  // a device's too
+  if (window_) {      // a device's buffers too
+    if (live_ && live_->world) live_->world->setPhysicsPath(PhysicsPath::Cpu, nullptr);
+    if (play_) play_->setPhysics(PhysicsPath::Cpu);
+  }
   if (window_) glfwDestroyWindow(window_);
   window_ = nullptr;
   glfwTerminate();

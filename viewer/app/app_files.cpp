@@ -16,6 +16,9 @@ bool App::openFile(const std::string& path) {
     if (looksLikeRecording(path)) {
       std::unique_ptr<Playback> p = Playback::open(path, opt_.threads);
       play_ = std::move(p);
+      if (live_->physics != PhysicsPath::Cpu)  // the path the live session ran on
+        if (const std::string why = play_->setPhysics(live_->physics); !why.empty())
+          showError(std::string("physics ") + physicsPathName(live_->physics) + ": " + why + " (playing on the CPU)");
       play_->playing = !scripted_;  // interactive: starts playing; scripts start paused (exact ticks)
       status_ = "playing " + path;
     } else {

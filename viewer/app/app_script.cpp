@@ -89,9 +89,8 @@ int App::runCommand(const ScriptCommand& c) {
       restartLive();
       return kGoOn;
     case K::Physics: {
-      if (play_) return bad("physics: expected a live session (recordings play on the CPU in the viewer)");
       const PhysicsPath path = PhysicsPath(c.count);
-      if (const std::string why = live_->setPhysics(path); !why.empty())
+      if (const std::string why = play_ ? play_->setPhysics(path) : live_->setPhysics(path); !why.empty())
         showError(std::string("physics ") + physicsPathName(path) + ": " + why);  // as the panel: the session goes on
       else
         status_ =

@@ -15,9 +15,8 @@ namespace {
 /// `--ab-variant physics=gpu`) is told where the GPU path is.
 std::unique_ptr<sg::ParticleDeviceProvider> noDeviceBeforeTheWindow(std::string* error) {
   *error =
-      "the viewer runs GPU physics for live scenarios (--physics gpu); recordings play on the CPU here "
-      "(`simgrass replay R.sgr --physics gpu --verify` and `simgrass compare R.sgr --variant physics=gpu` run them "
-      "on the device)";
+      "the viewer's device lives in its window's context, made after the inputs are read: play the recording "
+      "there with --physics gpu (`simgrass compare R.sgr --variant physics=gpu` compares the two paths)";
   return nullptr;
 }
 }  // namespace
@@ -58,12 +57,6 @@ int main(int argc, char** argv) {
   std::string startupError;
   const bool recording = !o.input.empty() && looksLikeRecording(o.input);
   registerGpuPhysics(&noDeviceBeforeTheWindow);
-  if (recording && o.physics != "cpu") {
-    std::string why;
-    noDeviceBeforeTheWindow(&why);
-    std::fprintf(stderr, "simgrass-viewer: --physics %s: %s\n", o.physics.c_str(), why.c_str());
-    return kExitBadInput;
-  }
   try {
     if (recording && !o.record.empty())
       throw std::invalid_argument("--record: expected a scenario to record, got the recording '" + o.input + "'");

@@ -42,7 +42,8 @@ int parseOptions(int argc, char** argv, Options* o) {
                "A bad input file opens the window anyway (built-in meadow) and shows the error there");
   app.add_option("--threads", o->threads, "Simulation worker threads")->check(CLI::Range(1, 256));
   app.add_option("--physics", o->physics,
-                 "Where a live scenario's grass stages run: cpu, gpu (compute shaders in the window's context; "
+                 "Where the grass stages run (a live scenario or a recording): cpu, gpu (compute shaders in the "
+                 "window's context; "
                  "the tufts are drawn from the device's buffers, nothing copied back) or gpu-readback "
                  "(docs/gpu-physics.md)")
       ->check(CLI::IsMember({"cpu", "gpu", "gpu-readback"}));

@@ -19,7 +19,7 @@ struct Options {
   std::string abFile;     ///< --ab B.sgr: a second recording to compare with
   std::string abVariant;  ///< --ab-variant SETTINGS: the same recording under a VariantSettings
   int64_t frames = -1;
-  std::string physics = "cpu";  ///< --physics: where a live scenario's grass stages run
+  std::string physics = "cpu";  ///< --physics: where the grass stages run (live or playback)
   int threads = 1;
   int msaa = 4;
   bool noScenarioInput = false;

@@ -95,6 +95,7 @@ void App::panelPlayback() {
   if (!ImGui::CollapsingHeader("Playback", ImGuiTreeNodeFlags_DefaultOpen)) return;
   std::string error;
   ImGui::Text("%s", play_->recording().file.c_str());
+  ImGui::TextDisabled("physics: %s", describePhysics(world()).c_str());
   ImGui::Text("tick %" PRId64 " / %" PRId64, play_->tick(), play_->lastTick());
   if (play_->busy()) {
     ImGui::Text("seeking to tick %" PRId64 "...", play_->target());

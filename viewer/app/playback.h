@@ -32,6 +32,8 @@ class Playback {
 
   const sgr::Recording& recording() const { return *rec_; }
   SimWorld& world() { return player_->world(); }
+  /// Where the played world's grass stages run (Player::setPhysics): "" or why not.
+  std::string setPhysics(PhysicsPath path) { return player_->setPhysics(path); }
   const Scenario& scenario() const { return player_->scenario(); }
   int64_t tick() const { return player_->tick(); }
   int64_t lastTick() const { return rec_->lastTick(); }
