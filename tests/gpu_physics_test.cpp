@@ -268,13 +268,13 @@ TEST(GpuPhysics, RenderDrawsTheDevicesTopsWithoutCopyingThemBack) {
 TEST(GpuPhysics, TheViewerDrawsFromTheDeviceInItsOwnContext) {
   TempDir dir;
   const std::string scenario = quote(test::sourcePath("scenarios/wind-fronts.json"));
-  const std::string window = " --size 320x180 --msaa 0";
-  // The panels hidden (F2): they show timings. On the device from tick 0, to the CPU at tick 20
-  // and back at 30; drawn at tick 40 from the device's buffer.
-  dir.write("cpu.txt", "tap f2\nframes 40\nscreenshot " + dir.file("cpu.png") + "\nprint\nframes 10\nprint\nquit\n");
-  dir.write("gpu.txt", "tap f2\nframes 20\nphysics cpu\nframes 10\nphysics gpu\nframes 10\nscreenshot " +
+  const std::string window = " --size 240x136 --msaa 0";
+  // The panels hidden (F2): they show timings. On the device from tick 0, to the CPU at tick 8
+  // and back at 12; drawn at tick 20 from the device's buffer.
+  dir.write("cpu.txt", "tap f2\nframes 20\nscreenshot " + dir.file("cpu.png") + "\nprint\nframes 6\nprint\nquit\n");
+  dir.write("gpu.txt", "tap f2\nframes 8\nphysics cpu\nframes 4\nphysics gpu\nframes 8\nscreenshot " +
                            dir.file("gpu.png") +
-                           "\nprint\nphysics gpu-readback\nframes 5\nphysics cpu\nframes 5\nprint\nquit\n");
+                           "\nprint\nphysics gpu-readback\nframes 3\nphysics cpu\nframes 3\nprint\nquit\n");
   const CliResult cpu = viewer_test::runViewer(scenario + " --script " + quote(dir.file("cpu.txt")) + window);
   const CliResult gpu =
       viewer_test::runViewer(scenario + " --physics gpu --script " + quote(dir.file("gpu.txt")) + window);
@@ -285,14 +285,14 @@ TEST(GpuPhysics, TheViewerDrawsFromTheDeviceInItsOwnContext) {
     for (size_t i = 0; i < n; ++i) at = out.find('\n', at) + 1;
     return out.substr(at, out.find('\n', at) - at);
   };
-  EXPECT_NE(line(cpu.out, 0).find("tick 40"), std::string::npos) << cpu.out;
-  EXPECT_EQ(line(gpu.out, 0), line(cpu.out, 0));  // tick 40: the same hash
-  EXPECT_EQ(line(gpu.out, 1), line(cpu.out, 1));  // tick 50, after gpu-readback and the CPU
+  EXPECT_NE(line(cpu.out, 0).find("tick 20"), std::string::npos) << cpu.out;
+  EXPECT_EQ(line(gpu.out, 0), line(cpu.out, 0));  // tick 20: the same hash
+  EXPECT_EQ(line(gpu.out, 1), line(cpu.out, 1));  // tick 26, after gpu-readback and the CPU
   const std::vector<uint8_t> a = readBytes(dir.file("cpu.png")), b = readBytes(dir.file("gpu.png"));
   ASSERT_FALSE(a.empty());
   EXPECT_TRUE(a == b) << "the frame drawn from the device differs from the CPU's";
   // A recording plays on the device too, every recorded hash checked as it plays.
-  dir.write("play.txt", "play\nframes 30\npause\nprint\nquit\n");
+  dir.write("play.txt", "play\nframes 12\npause\nprint\nquit\n");
   const CliResult play = viewer_test::runViewer(quote(test::sourcePath("scenarios/recordings/thesis-meadow-fx32.sgr")) +
                                                 " --physics gpu --script " + quote(dir.file("play.txt")) + window);
   ASSERT_EQ(play.exitCode, 0) << play.describe();
