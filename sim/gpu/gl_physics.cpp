@@ -231,11 +231,18 @@ class GlParticleDevice final : public ParticleDevice<S> {
     if (dx) get(displacement_, {dx, dy, dz});
   }
 
-  void derivePatches(const DevicePatchInputs<S>& in) override {
+  bool derivePatches(const DevicePatchInputs<S>& in) override {
     context_->makeCurrent();
     const int64_t patchCount = in.patches.size();
+    if (!patchesFit_) return false;
     if (patchCount != patchCount_) {  // the window's size is fixed: allocated once per world
+      // Each output array set is one storage block, as the particles' are (GlPhysicsProvider::make).
+      GLint64 maxBlock = 0;
+      glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
+      patchesFit_ = 4 * patchCount * int64_t(sizeof(Raw)) <= int64_t(maxBlock) &&
+                    patchCount * int64_t(4 * sizeof(float)) <= int64_t(maxBlock);
       patchCount_ = patchCount;
+      if (!patchesFit_) return false;
       glNamedBufferData(rootY_, patchCount * GLsizeiptr(sizeof(Raw)), nullptr, GL_DYNAMIC_DRAW);
       glNamedBufferData(cut_, patchCount * GLsizeiptr(sizeof(GLuint)), nullptr, GL_DYNAMIC_DRAW);
       glNamedBufferData(patchOut_, 4 * patchCount * GLsizeiptr(sizeof(Raw)), nullptr, GL_DYNAMIC_COPY);
@@ -280,6 +287,7 @@ class GlParticleDevice final : public ParticleDevice<S> {
     // A renderer reads the draw copy as a vertex attribute or a buffer texture.
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT |
                     GL_TEXTURE_FETCH_BARRIER_BIT);
+    return true;
   }
 
   void downloadPatches(PatchArrays<S>& patches) override {
@@ -296,7 +304,7 @@ class GlParticleDevice final : public ParticleDevice<S> {
     }
   }
 
-  uint32_t patchDrawBuffer() const override { return patchCount_ > 0 ? patchDraw_ : 0; }
+  uint32_t patchDrawBuffer() const override { return patchCount_ > 0 && patchesFit_ ? patchDraw_ : 0; }
   DeviceTraffic traffic() const override { return traffic_; }
 
  private:
@@ -377,6 +385,7 @@ class GlParticleDevice final : public ParticleDevice<S> {
   GLuint patchConstantBuffer_ = 0, rootY_ = 0, cut_ = 0, patchOut_ = 0, patchDraw_ = 0;
   GLsizeiptr patchConstantCapacity_ = 0;
   int64_t patchCount_ = 0;
+  bool patchesFit_ = true;      ///< the window's patches fit the device's storage blocks
   uint64_t patchRevision_ = 0;  ///< of the inputs on the device (0: none)
   std::vector<Raw> patchConstants_;
   std::vector<GLuint> cutWords_;

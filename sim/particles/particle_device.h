@@ -72,8 +72,9 @@ class ParticleDevice {
   virtual void download(ParticleArrays<S>& p, std::vector<S>* dx, std::vector<S>* dy, std::vector<S>* dz) = 0;
   /// The patch stage on the device, from the last pass's tip displacement: every patch slot's tip
   /// offset, top and tilt level with the CPU's bits (PatchWriter::writeFast after updatePatchRow),
-  /// and a copy for drawing (patchDrawBuffer).
-  virtual void derivePatches(const DevicePatchInputs<S>& inputs) = 0;
+  /// and a copy for drawing (patchDrawBuffer). False when the device cannot hold this window's
+  /// patches (its storage blocks are too small): the host then derives and draws its own.
+  virtual bool derivePatches(const DevicePatchInputs<S>& inputs) = 0;
   /// Copies the last derivePatches' tip offsets, tops and tilt levels into `patches` (checks).
   virtual void downloadPatches(PatchArrays<S>& patches) = 0;
   /// A renderer sharing the device's context draws from this buffer (an OpenGL buffer name; 0

@@ -121,12 +121,10 @@ bool World<S>::deviceParticlePass() {
 template <class S>
 bool World<S>::deriveDevicePatches() const {
   if (!device_ || !deviceDisplacementCurrent_) return false;
-  if (!devicePatchesCurrent_) {
-    device_->derivePatches(DevicePatchInputs<S>{grid_.window, patchWindow_, &patchConsts_, &patches_.rootY,
-                                                &patches_.cut, patchInputsRevision_});
-    devicePatchesCurrent_ = true;
-  }
-  return true;
+  if (!devicePatchesCurrent_)
+    devicePatchesCurrent_ = device_->derivePatches(DevicePatchInputs<S>{
+        grid_.window, patchWindow_, &patchConsts_, &patches_.rootY, &patches_.cut, patchInputsRevision_});
+  return devicePatchesCurrent_;
 }
 
 template <class S>
