@@ -149,23 +149,34 @@ INSTANTIATE_TEST_SUITE_P(Goldens, GpuGolden, ::testing::ValuesIn(goldenRuns()),
                            return n;
                          });
 
+/// wind-fronts (gust fronts) under a level-of-detail window of side x side particles.
+Scenario windowedWindFronts(const char* scalar, int side) {
+  Scenario s = scenarioNamed("wind-fronts", scalar);
+  s.lod.mode = LodMode::Window;
+  s.lod.windowX = s.lod.windowZ = side;
+  s.lod.edgeRows = 4;
+  return s;
+}
+
+/// The camera at tick t, drifting from the field's -x/-z corner (-14.06 m) across it by x256 and
+/// z256 / 256 m a tick (as Q32.32), which moves the window.
+TickInput driftingCamera(int64_t t, int64_t x256, int64_t z256) {
+  TickInput in;
+  in.hasCamera = true;
+  in.camera = {(-3600 + x256 * t) << 24, 0, (-3600 + z256 * t) << 24};
+  return in;
+}
+
 /// A level-of-detail window moving under gust fronts (the golden lod-crossing has row-uniform
 /// wind): each move copies the particles back, writes the entering cells and uploads them again,
 /// and a gust run that wraps round the window's toroidal storage is split as the CPU splits it.
 TEST(GpuPhysics, AMovingWindowUnderGustFrontsMatchesTheCpu) {
   for (const char* scalar : {"fx32", "fx16"}) {
-    Scenario s = scenarioNamed("wind-fronts", scalar);
-    s.lod.mode = LodMode::Window;
-    s.lod.windowX = s.lod.windowZ = 31;
-    s.lod.edgeRows = 4;
+    const Scenario s = windowedWindFronts(scalar, 31);
     auto cpu = makeWorld(s, 1);
     auto gpu = onPath(s, PhysicsPath::Gpu);
-    TickInput in;
-    in.hasCamera = true;
     for (int64_t t = 1; t <= 300; ++t) {
-      // The camera drifts from the field's -x/-z corner across it (m, as Q32.32).
-      const int64_t metresX256 = -3600 + 24 * t, metresZ256 = -3600 + 17 * t;
-      in.camera = {metresX256 << 24, 0, metresZ256 << 24};
+      const TickInput in = driftingCamera(t, 24, 17);
       ASSERT_TRUE(cpu->step(in).ok);
       ASSERT_TRUE(gpu->step(in).ok);
       if (t % 30 == 0) {
@@ -182,18 +193,11 @@ TEST(GpuPhysics, AMovingWindowUnderGustFrontsMatchesTheCpu) {
 TEST(GpuPhysics, DevicePatchStageIsTheHostsAtEveryInterpolation) {
   for (const char* scalar : {"fx32", "fx16"})
     for (int k : {1, 2, 3, 4}) {
-      Scenario s = scenarioNamed("wind-fronts", scalar);
+      Scenario s = windowedWindFronts(scalar, 23);
       s.particles.interpolation = k;
-      s.lod.mode = LodMode::Window;
-      s.lod.windowX = s.lod.windowZ = 23;
-      s.lod.edgeRows = 4;
       auto gpu = onPath(s, PhysicsPath::Gpu);
-      TickInput in;
-      in.hasCamera = true;
       for (int64_t t = 1; t <= 120; ++t) {
-        const int64_t metresX256 = -3600 + 30 * t, metresZ256 = -3600 + 21 * t;
-        in.camera = {metresX256 << 24, 0, metresZ256 << 24};
-        ASSERT_TRUE(gpu->step(in).ok);
+        ASSERT_TRUE(gpu->step(driftingCamera(t, 30, 21)).ok);
         if (t % 40 == 0) {
           ASSERT_TRUE(devicePatchesAreTheHosts(*gpu)) << scalar << " k " << k << " tick " << t;
         }
@@ -221,16 +225,8 @@ TEST(GpuPhysics, TheResidentPathCopiesBackOnlyTheFaultWord) {
   EXPECT_NE(gpu->devicePatchDrawBuffer(), 0u);
   // A level-of-detail window moving under the camera: the host writes the entering cells and
   // sends just those up; nothing comes back.
-  Scenario moving = scenarioNamed("wind-fronts", "fx32");
-  moving.lod.mode = LodMode::Window;
-  moving.lod.windowX = moving.lod.windowZ = 31;
-  auto window = onPath(moving, PhysicsPath::Gpu);
-  TickInput in;
-  in.hasCamera = true;
-  for (int64_t t = 1; t <= 90; ++t) {
-    in.camera = {(-3600 + 40 * t) << 24, 0, (-3600 + 25 * t) << 24};
-    ASSERT_TRUE(window->step(in).ok);
-  }
+  auto window = onPath(windowedWindFronts("fx32", 31), PhysicsPath::Gpu);
+  for (int64_t t = 1; t <= 90; ++t) ASSERT_TRUE(window->step(driftingCamera(t, 40, 25)).ok);
   EXPECT_GT(window->counts().windowOriginI, 0) << "the window was meant to move";
   EXPECT_EQ(window->deviceTraffic().toHost, 90 * 4);
   auto readback = onPath(s, PhysicsPath::GpuReadback);
