@@ -567,7 +567,7 @@ void deviceMatchesTheReference(GrassModel model, bool tramples) {
   RC_ASSERT(device != nullptr);
   device->upload(p);
   uint32_t bits = 0;
-  const RowFault got = device->advance(wind, c, &bits);
+  const RowFault got = device->advance(wind, c, nullptr, &bits);
   RC_ASSERT(got.particle == expected.particle);
   ParticleArrays<S> out = p;
   std::vector<S> dx(static_cast<size_t>(n)), dy(dx), dz(dx);
@@ -594,6 +594,192 @@ RC_GTEST_PROP(GpuArithmetic, Fx32PassIsTheReference, ()) {
 RC_GTEST_PROP(GpuArithmetic, Fx16PassIsTheReference, ()) {
   deviceMatchesTheReference<Fx16>(*genModel(), *rc::gen::arbitrary<bool>());
 }
+
+// ---- bodies pushing the grass on the device ---------------------------------------------------
+
+/// A random scene of bodies in a small meadow (thesis-bodies' grass): 1 to 6 spheres, boxes and
+/// two-part compounds, turned every way, thrown into the tufts at up to 4 m/s, with masses from
+/// 1 to 1000 kg; every grass model, box normal, tip contact, grass broad phase and grass drag;
+/// sometimes a level-of-detail window the camera drags across the field, so rows and columns
+/// wrap in storage. The device's fused push must give the CPU's state, tick by tick.
+template <class S>
+void bodyPushesAreTheCpus() {
+  Scenario s = scenarioNamed("thesis-bodies", ScalarTraits<S>::kind == ScalarKind::Fx32 ? "fx32" : "fx16");
+  s.field.patchesX = *rc::gen::inRange<int64_t>(12, 29);
+  s.field.patchesZ = *rc::gen::inRange<int64_t>(12, 29);
+  s.particles.model = *genModel();
+  if (s.particles.model == GrassModel::Blade && *rc::gen::arbitrary<bool>())
+    s.particles.blade.trampleSeconds = Rational{2, 1};
+  s.bodies.boxParticleNormal = *rc::gen::element(BoxParticleNormal::Up, BoxParticleNormal::NearestFace);
+  s.bodies.tipContact = *rc::gen::element(TipContact::Push, TipContact::Hold);
+  s.bodies.particleBroadphase = *rc::gen::element(ParticleBroadphase::Grid, ParticleBroadphase::Brute);
+  s.bodies.grassDrag = *rc::gen::element(Rational{0, 1}, Rational{1, 2});
+  s.script.clear();
+  s.bodies.list.clear();
+  const auto cm = [](int v) { return *Rational::make(v, 100); };
+  const auto halfWidth = [&](int64_t patches) { return int(patches * 25 / 2); };  // cm (0.25 m spacing)
+  const int bodies = *rc::gen::inRange(1, 7);
+  for (int b = 0; b < bodies; ++b) {
+    BodySpec body;
+    body.name = "b" + std::to_string(b);
+    const int kind = *rc::gen::inRange(0, 3);  // sphere, box, compound
+    for (int k = 0; k < (kind == 2 ? 2 : 1); ++k) {
+      ShapeSpec part;
+      part.type = (kind == 0 || (kind == 2 && k == 0)) ? ShapeType::Sphere : ShapeType::Box;
+      part.radius = cm(*rc::gen::inRange(8, 80));
+      part.halfExtents = {cm(*rc::gen::inRange(5, 70)), cm(*rc::gen::inRange(5, 70)), cm(*rc::gen::inRange(5, 70))};
+      if (kind == 2) part.offset = {cm(k == 0 ? -30 : 30), cm(0), cm(*rc::gen::inRange(-20, 21))};
+      body.parts.push_back(part);
+    }
+    body.compound = kind == 2;
+    body.mass = Rational{*rc::gen::element<int64_t>(1, 5, 80, 1000), 1};
+    const int wx = halfWidth(s.field.patchesX), wz = halfWidth(s.field.patchesZ);
+    body.position = {cm(*rc::gen::inRange(-wx, wx + 1)), cm(*rc::gen::inRange(5, 90)),
+                     cm(*rc::gen::inRange(-wz, wz + 1))};
+    body.orientation = {cm(*rc::gen::inRange(1, 101)), cm(*rc::gen::inRange(-100, 101)),
+                        cm(*rc::gen::inRange(-100, 101)), cm(*rc::gen::inRange(-100, 101))};
+    body.velocity = {cm(*rc::gen::inRange(-400, 401)), cm(*rc::gen::inRange(-100, 101)),
+                     cm(*rc::gen::inRange(-400, 401))};
+    body.angularVelocity = {cm(*rc::gen::inRange(-300, 301)), cm(*rc::gen::inRange(-300, 301)),
+                            cm(*rc::gen::inRange(-300, 301))};
+    s.bodies.list.push_back(body);
+  }
+  const bool window = *rc::gen::arbitrary<bool>();
+  if (window) {
+    s.lod.mode = LodMode::Window;
+    s.lod.windowX = s.field.patchesX - 4;
+    s.lod.windowZ = s.field.patchesZ - 3;
+    s.lod.edgeRows = 2;
+  }
+  RC_TAG(s.particles.model == GrassModel::Blade ? "blade"
+         : s.particles.model == GrassModel::Pbd ? "pbd"
+                                                : "thesis",
+         s.bodies.boxParticleNormal == BoxParticleNormal::Up ? "up" : "nearest-face",
+         s.bodies.tipContact == TipContact::Hold ? "hold" : "push", window ? "window" : "field");
+  auto cpu = makeWorld(s, 1);
+  auto gpu = onPath(s, PhysicsPath::Gpu);
+  for (int64_t t = 0; t < 24; ++t) {
+    TickInput in = scriptedInput(s, t);
+    if (window) {  // from the -x/-z corner, a particle spacing a tick along x, half of one along z
+      in.hasCamera = true;
+      in.camera = {(int64_t(-halfWidth(s.field.patchesX) + 25 * t) << 32) / 100, 0,
+                   (int64_t(-halfWidth(s.field.patchesZ) + 12 * t) << 32) / 100};
+    }
+    const bool cpuOk = cpu->step(in).ok, gpuOk = gpu->step(in).ok;
+    RC_ASSERT(cpuOk == gpuOk);
+    if (!cpuOk) {
+      RC_TAG("failed");
+      RC_ASSERT(gpu->stateHash() == cpu->stateHash());
+      return;
+    }
+    if (t % 8 == 7) RC_ASSERT(hex(gpu->stateHash()) == hex(cpu->stateHash()));
+  }
+  // It ran on the device: only the fault words and the hashes' copies came back (a pass handed
+  // back to the CPU would copy the whole state back besides).
+  const DeviceTraffic traffic = gpu->deviceTraffic();
+  const WorldCounts counts = gpu->counts();
+  const int64_t stateBytes = counts.particlesX * counts.particlesZ * int64_t(sizeof(S)) * 10;
+  RC_ASSERT(traffic.toHost <= 3 * stateBytes + 24 * 4 + 24 * 4 * 7);
+}
+
+// Spheres in a line pass a tuft tip on (grass_candidates_test.cpp's chain; here four heavy
+// spheres asleep in the air, so no contact moves them): each pushes the tip out of its far side
+// into the next, two radii beyond the lattice ranges' allowance, to a sphere whose range does not
+// hold the tip's root, so the tip must meet every later part in order (the escape), along x
+// within its row and along z through parts bucketed in other rows. One tick on each path.
+template <class S>
+void chainedPushesAreTheCpus(bool alongZ) {
+  Scenario scenario = test::thesisMeadow();
+  scenario.field.patchesX = scenario.field.patchesZ = 40;
+  scenario.wind.schedule.clear();
+  scenario.bodies.gravity = test::r3(0, 0, 0);
+  for (int k = 0; k < 4; ++k) {
+    BodySpec b = test::sphere("link", Rational{1, 2}, test::r3(0, 5, 0));
+    b.name += std::to_string(k);
+    b.mass = Rational{1000, 1};
+    scenario.bodies.list.push_back(b);
+  }
+  auto cpu = test::makeTyped<S>(scenario);
+  auto gpu = test::makeTyped<S>(scenario);
+  ASSERT_EQ(gpu->setPhysicsPath(PhysicsPath::Gpu, &provider()), "");
+  for (World<S>* w : {cpu.get(), gpu.get()}) {
+    ParticleArrays<S>& particles = w->mutableParticles();
+    const size_t tip = particles.px.size() / 2 + 7;
+    for (size_t i = 0; i < particles.px.size(); ++i) particles.py[i] = particles.anchorY[i] + S(1);  // upright
+    const S ax = particles.anchorX[tip], ay = particles.anchorY[tip], az = particles.anchorZ[tip];
+    const auto cm = [](int v) { return S(v) / S(100); };
+    // The tip 0.99 m out from its root at 0.6 m, 1 cm past the first sphere's centre; each next
+    // sphere sits 1 cm short of where the last one leaves it.
+    const auto along = [&](int centimetres) {
+      return alongZ ? Vec3<S>(ax, ay + cm(60), az + cm(centimetres)) : Vec3<S>(ax + cm(centimetres), ay + cm(60), az);
+    };
+    const Vec3<S> start = along(99);
+    particles.px[tip] = start.x();
+    particles.py[tip] = start.y();
+    particles.pz[tip] = start.z();
+    std::vector<RigidBody<S>>& bodies = w->mutableBodies();
+    for (size_t k = 0; k < bodies.size(); ++k) {
+      bodies[k].position = along(98 + 49 * int(k));
+      bodies[k].asleep = true;
+    }
+  }
+  ASSERT_TRUE(cpu->step(TickInput{}).ok);
+  ASSERT_TRUE(gpu->step(TickInput{}).ok);
+  // The chain carried the tip through all four, to 2.95 m out and 0.6 m up before the rod took
+  // it back: 0.980 m out on the rod (through three, 2.46 m out: 0.971 m).
+  const ParticleArrays<S>& moved = cpu->particles();
+  const size_t tip = moved.px.size() / 2 + 7;
+  const S out = alongZ ? moved.pz[tip] - moved.anchorZ[tip] : moved.px[tip] - moved.anchorX[tip];
+  EXPECT_GT(ScalarTraits<S>::toDouble(out), 0.975) << "the tip went through every sphere";
+  EXPECT_EQ(hex(gpu->stateHash()), hex(cpu->stateHash())) << (alongZ ? "along z" : "along x");
+}
+
+TEST(GpuBodies, ChainedPushesAreTheCpus) {
+  for (bool alongZ : {false, true}) {
+    chainedPushesAreTheCpus<Fx32>(alongZ);
+    chainedPushesAreTheCpus<Fx16>(alongZ);
+  }
+}
+
+// The grass drag from the device's tuft counts, and a push that faults (a tuft 32 km down under a
+// ball 800 m up: the difference overflows Q16.16 in the push's reach test): the pass hands the
+// tick back, and the host redoes the push from the tick's input and reports the reference's
+// fault, with the reference's state.
+TEST(GpuBodies, GrassDragAndAPushFaultAreTheCpus) {
+  Scenario scenario = scenarioNamed("thesis-bodies", "fx16");
+  scenario.field.patchesX = scenario.field.patchesZ = 20;
+  scenario.script.clear();
+  scenario.bodies.gravity = test::r3(0, 0, 0);
+  scenario.bodies.grassDrag = Rational{1, 2};
+  scenario.bodies.list = {test::sphere("rolling", Rational{3, 10}, test::r3(-1, 3, 0, 10)),
+                          test::sphere("high", Rational{1, 2}, test::r3(1, 800, 0))};
+  scenario.bodies.list[0].velocity = test::r3(1, 0, 0);
+  auto cpu = test::makeTyped<Fx16>(scenario);
+  auto gpu = test::makeTyped<Fx16>(scenario);
+  ASSERT_EQ(gpu->setPhysicsPath(PhysicsPath::Gpu, &provider()), "");
+  for (int64_t t = 0; t < 3; ++t) {
+    ASSERT_TRUE(cpu->step(TickInput{}).ok);
+    ASSERT_TRUE(gpu->step(TickInput{}).ok);
+  }
+  EXPECT_EQ(gpu->bodies()[0].velocity, cpu->bodies()[0].velocity);
+  EXPECT_LT(cpu->bodies()[0].velocity.x(), Fx16(1)) << "the grass drags the rolling ball";
+  for (World<Fx16>* w : {cpu.get(), gpu.get()}) {  // the tuft under the high ball
+    ParticleArrays<Fx16>& p = w->mutableParticles();
+    size_t under = 0;
+    const auto away = [&](size_t i) { return abs(p.anchorX[i] - Fx16(1)) + abs(p.anchorZ[i]); };
+    for (size_t i = 1; i < p.px.size(); ++i) under = away(i) < away(under) ? i : under;
+    p.py[under] = Fx16(-32000);
+  }
+  ASSERT_EQ(hex(gpu->stateHash()), hex(cpu->stateHash()));
+  const StepResult onCpu = cpu->step(TickInput{}), onGpu = gpu->step(TickInput{});
+  ASSERT_FALSE(onCpu.ok);
+  EXPECT_EQ(onCpu.error.stage, Stage::Response);
+  EXPECT_EQ(onGpu.error.message(), onCpu.error.message());
+  EXPECT_EQ(hex(gpu->stateHash()), hex(cpu->stateHash()));
+}
+
+RC_GTEST_PROP(GpuBodies, Fx32PushesAreTheCpus, ()) { bodyPushesAreTheCpus<Fx32>(); }
+RC_GTEST_PROP(GpuBodies, Fx16PushesAreTheCpus, ()) { bodyPushesAreTheCpus<Fx16>(); }
 
 }  // namespace
 }  // namespace sg

@@ -140,10 +140,19 @@ bool World<S>::respondToContacts() {
   sweepFastBodiesAgainstTerrain(bodies_, start, terrain_, solver_.linearSlop);
   if (bodiesFaulted(Stage::Response)) return false;
   mowGrass();
-  // Grass: pushed out of every body (particle rows in parallel, bodies in id order).
-  const GrassPushers<S> pushers = prepareGrassPushers(bodies_, grid_, bodyParticle_);
-  // On a device the pushed rows come to the host and go back (world_device.cpp).
-  if (device_) bringPushedRowsToHost(pushers);
+  // Grass: pushed out of every body. On a device the particle pass applies the push before it
+  // integrates (world_device.cpp): the particles stay there.
+  GrassPushers<S> pushers = prepareGrassPushers(bodies_, grid_, bodyParticle_);
+  if (device_) {
+    devicePushers_ = std::move(pushers);
+    devicePushPending_ = true;
+    return true;
+  }
+  return pushGrassOnHost(pushers);
+}
+
+template <class S>
+bool World<S>::pushGrassOnHost(const GrassPushers<S>& pushers) {
   const bool drag = grassDragDt_ > S(0);
   // Per-row push counts (integers, summed in row order below: the same for any thread count).
   std::vector<int64_t> pushed(drag ? size_t(grid_.countZ) * bodies_.size() : 0, 0);
@@ -152,9 +161,16 @@ bool World<S>::respondToContacts() {
                                     drag ? pushed.data() + size_t(row) * bodies_.size() : nullptr, particleKernel_);
   });
   if (!ok || !drag) return ok;
+  std::vector<int64_t> perBody(bodies_.size(), 0);
+  for (size_t b = 0; b < bodies_.size(); ++b)
+    for (int64_t row = 0; row < grid_.countZ; ++row) perBody[b] += pushed[size_t(row) * bodies_.size() + b];
+  return applyGrassDrag(perBody);
+}
+
+template <class S>
+bool World<S>::applyGrassDrag(const std::vector<int64_t>& pushedPerBody) {
   for (size_t b = 0; b < bodies_.size(); ++b) {
-    int64_t tufts = 0;
-    for (int64_t row = 0; row < grid_.countZ; ++row) tufts += pushed[size_t(row) * bodies_.size() + b];
+    const int64_t tufts = pushedPerBody[b];
     if (tufts == 0) continue;
     RigidBody<S>& body = bodies_[b];
     const S loss = minS(S(1), mulInt(grassDragDt_ * body.invMass, tufts));
@@ -164,10 +180,12 @@ bool World<S>::respondToContacts() {
   return !bodiesFaulted(Stage::Response);
 }
 
-#define SG_INSTANTIATE_CONTACTS(S)              \
-  template void World<S>::detectContacts();     \
-  template bool World<S>::bodiesFaulted(Stage); \
-  template bool World<S>::respondToContacts();
+#define SG_INSTANTIATE_CONTACTS(S)                                 \
+  template void World<S>::detectContacts();                        \
+  template bool World<S>::bodiesFaulted(Stage);                    \
+  template bool World<S>::respondToContacts();                     \
+  template bool World<S>::pushGrassOnHost(const GrassPushers<S>&); \
+  template bool World<S>::applyGrassDrag(const std::vector<int64_t>&);
 
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE_CONTACTS)
 

@@ -73,7 +73,10 @@ enum Binding : GLuint {
   kFault,
   kRuns,
   kTrampleIn,
-  kTrampleOut
+  kTrampleOut,
+  kPushValues,
+  kPushInts,
+  kPushCounts
 };
 // The patch pass's bindings (kPatchPassGlsl).
 enum PatchBinding : GLuint { kPatchDisplacement, kPatchConstants, kPatchRootY, kPatchCut, kPatchOut, kPatchDraw };
@@ -114,10 +117,13 @@ class GlParticleDevice final : public ParticleDevice<S> {
     for (GLuint b : {position_[0], position_[1], velocity_[0], velocity_[1], anchor_, displacement_})
       glNamedBufferData(b, 3 * arrayBytes(), nullptr, GL_DYNAMIC_COPY);
     for (GLuint b : trample_) glNamedBufferData(b, tramples ? arrayBytes() : 16, nullptr, GL_DYNAMIC_COPY);
+    for (GLuint b : {pushValues_, pushInts_, pushCounts_}) glNamedBufferData(b, 16, nullptr, GL_STREAM_DRAW);
     glNamedBufferData(fault_, sizeof(GLuint), nullptr, GL_STREAM_READ);
     countXLocation_ = glGetUniformLocation(program_, "countX");
     countZLocation_ = glGetUniformLocation(program_, "countZ");
     countLocation_ = glGetUniformLocation(program_, "count");
+    pushPartsLocation_ = glGetUniformLocation(program_, "pushParts");
+    pushFlagsLocation_ = glGetUniformLocation(program_, "pushFlags");
   }
   ~GlParticleDevice() override {  // the program is the provider's
     context_->makeCurrent();
@@ -136,7 +142,8 @@ class GlParticleDevice final : public ParticleDevice<S> {
     if (tramples_) put(trample_[current_], {&p.trample});
   }
 
-  RowFault advance(const DeviceWind<S>& wind, const ParticleConstants<S>& c, uint32_t* faultBits) override {
+  RowFault advance(const DeviceWind<S>& wind, const ParticleConstants<S>& c, const DevicePush<S>* push,
+                   uint32_t* faultBits) override {
     context_->makeCurrent();
     const size_t runCount = wind.runBegin.size();
     using St = Stored<S>;
@@ -161,6 +168,7 @@ class GlParticleDevice final : public ParticleDevice<S> {
     const GLuint none = 0xFFFFFFFFu;
     glNamedBufferSubData(fault_, 0, sizeof none, &none);
     traffic_.toDevice += GLsizeiptr(tick_.size() * sizeof(Raw) + runs_.size() * sizeof(int32_t) + sizeof none);
+    const GLuint pushParts = push ? packPush(*push) : 0;
     glUseProgram(program_);
     const GLuint next = 1 - current_;
     const std::pair<Binding, GLuint> bindings[] = {{kPositionIn, position_[current_]},
@@ -173,12 +181,17 @@ class GlParticleDevice final : public ParticleDevice<S> {
                                                    {kFault, fault_},
                                                    {kRuns, runBuffer_},
                                                    {kTrampleIn, trample_[current_]},
-                                                   {kTrampleOut, trample_[next]}};
+                                                   {kTrampleOut, trample_[next]},
+                                                   {kPushValues, pushValues_},
+                                                   {kPushInts, pushInts_},
+                                                   {kPushCounts, pushCounts_}};
     for (const auto& [binding, buffer] : bindings) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer);
     const int64_t n = countX_ * countZ_;
     glUniform1ui(countXLocation_, GLuint(countX_));
     glUniform1ui(countZLocation_, GLuint(countZ_));
     glUniform1ui(countLocation_, GLuint(n));
+    glUniform1ui(pushPartsLocation_, pushParts);
+    glUniform1ui(pushFlagsLocation_, pushFlags_);
     glDispatchCompute(GLuint((n + 255) / 256), 1, 1);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     // The one value every tick reads back: whether (and where) the pass faulted, which step()
@@ -186,6 +199,12 @@ class GlParticleDevice final : public ParticleDevice<S> {
     GLuint key = none;
     glGetNamedBufferSubData(fault_, 0, sizeof key, &key);
     traffic_.toHost += sizeof key;
+    if (pushParts > 0 && push->pushedPerBody && key == none) {  // the grass drag's tuft counts
+      pushCountWords_.resize(push->bodyCount);
+      glGetNamedBufferSubData(pushCounts_, 0, GLsizeiptr(push->bodyCount * sizeof(GLuint)), pushCountWords_.data());
+      traffic_.toHost += GLsizeiptr(push->bodyCount * sizeof(GLuint));
+      push->pushedPerBody->assign(pushCountWords_.begin(), pushCountWords_.end());
+    }
     *faultBits = 0;
     if (key == none) {
       current_ = next;
@@ -195,21 +214,6 @@ class GlParticleDevice final : public ParticleDevice<S> {
     // pass faults on a non-finite value, which has no fault bits.
     *faultBits = std::is_same_v<S, float> ? 0u : uint32_t(kFixedFaultOverflow);
     return decode(key, wind);
-  }
-
-  void downloadRows(ParticleArrays<S>& p, int64_t rowBegin, int64_t rowEnd) override {
-    context_->makeCurrent();
-    const Span rows{rowBegin * countX_, (rowEnd - rowBegin) * countX_};
-    get(position_[current_], {&p.px, &p.py, &p.pz}, rows);
-    get(velocity_[current_], {&p.vx, &p.vy, &p.vz}, rows);
-    if (tramples_) get(trample_[current_], {&p.trample}, rows);
-  }
-  void uploadRows(const ParticleArrays<S>& p, int64_t rowBegin, int64_t rowEnd) override {
-    context_->makeCurrent();
-    const Span rows{rowBegin * countX_, (rowEnd - rowBegin) * countX_};
-    put(position_[current_], {&p.px, &p.py, &p.pz}, rows);
-    put(velocity_[current_], {&p.vx, &p.vy, &p.vz}, rows);
-    if (tramples_) put(trample_[current_], {&p.trample}, rows);
   }
 
   void uploadCells(const ParticleArrays<S>& p, const std::vector<typename ParticleDevice<S>::Span>& spans) override {
@@ -344,6 +348,58 @@ class GlParticleDevice final : public ParticleDevice<S> {
     }
     glNamedBufferSubData(buffer, 0, bytes, values.data());
   }
+  /// Packs this tick's pushers for the pass (particle_pass_glsl.h, "body pushes") into the push
+  /// buffers, clears the per-body counts where they are kept, sets pushFlags_; returns the number
+  /// of parts (0: nothing to push).
+  GLuint packPush(const DevicePush<S>& push) {
+    const GrassPushers<S>& pushers = *push.pushers;
+    const BodyParticleSettings<S>& settings = *push.settings;
+    const size_t parts = pushers.parts.size();
+    if (parts == 0) return 0;
+    using St = Stored<S>;
+    pushValueData_.assign({St::of(settings.pushAllowance), St::of(settings.rodLength)});
+    pushIntData_.clear();
+    for (const GrassPusher<S>& p : pushers.parts) {
+      const Vec3<S>& c = p.pose.position;
+      for (int a = 0; a < 3; ++a) pushValueData_.push_back(St::of(c[a]));
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) pushValueData_.push_back(St::of(p.pose.rotation(r, k)));
+      const bool sphere = p.shape->type == ShapeType::Sphere;
+      for (int a = 0; a < 3; ++a)
+        pushValueData_.push_back(St::of(sphere ? (a == 0 ? p.shape->radius : S(0)) : p.shape->halfExtents[a]));
+      pushValueData_.push_back(St::of(p.share));
+      pushValueData_.push_back(St::of(p.candidateReach));
+      pushIntData_.insert(pushIntData_.end(), {sphere ? 0 : 1, p.body, int32_t(p.firstColumn),
+                                               int32_t(std::max<int64_t>(0, p.range.a1 - p.range.a0 + 1))});
+    }
+    // Each storage row's part list (the bucket of its lattice row), after the row bounds.
+    const size_t lists = pushIntData_.size();
+    pushIntData_.resize(lists + size_t(countZ_) + 1);
+    for (int64_t r = 0; r < countZ_; ++r) {
+      pushIntData_[lists + size_t(r)] = int32_t(pushIntData_.size());
+      const int64_t b = push.window->latticeRow(r) - pushers.originJ;
+      for (int64_t k = pushers.rowStart[size_t(b)]; k < pushers.rowStart[size_t(b + 1)]; ++k)
+        pushIntData_.push_back(pushers.byRow[size_t(k)]);
+    }
+    pushIntData_[lists + size_t(countZ_)] = int32_t(pushIntData_.size());
+    replaceContents(pushValues_, pushValueData_, &pushValueCapacity_);
+    replaceContents(pushInts_, pushIntData_, &pushIntCapacity_);
+    traffic_.toDevice += GLsizeiptr(pushValueData_.size() * sizeof(Raw) + pushIntData_.size() * sizeof(int32_t));
+    const bool counts = push.pushedPerBody != nullptr;
+    if (counts) {
+      const GLsizeiptr bytes = GLsizeiptr(std::max<size_t>(1, push.bodyCount) * sizeof(GLuint));
+      if (bytes > pushCountCapacity_) {
+        pushCountCapacity_ = std::max(bytes, 2 * pushCountCapacity_);
+        glNamedBufferData(pushCounts_, pushCountCapacity_, nullptr, GL_STREAM_READ);
+      }
+      const GLuint zero = 0;
+      glClearNamedBufferSubData(pushCounts_, GL_R32UI, 0, bytes, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    }
+    pushFlags_ = (settings.boxNormal == BoxParticleNormal::NearestFace ? 1u : 0u) | (settings.holdTips ? 2u : 0u) |
+                 (settings.broadphase == ParticleBroadphase::Grid ? 4u : 0u) | (counts ? 8u : 0u);
+    return GLuint(parts);
+  }
+
   /// The particle and stage of fault key `key` (particle_pass_glsl.h): after the row's base
   /// row 2 countX, run k covers [2 begin_k, 2 end_k), integration faults before projection ones.
   RowFault decode(GLuint key, const DeviceWind<S>& wind) const {
@@ -361,10 +417,10 @@ class GlParticleDevice final : public ParticleDevice<S> {
     return {row * countX_, Stage::Integrate};  // unreachable: the runs cover the row
   }
 
-  std::array<GLuint*, 16> buffers() {
-    return {&position_[0], &position_[1],  &velocity_[0], &velocity_[1], &trample_[0], &trample_[1],
-            &anchor_,      &displacement_, &tickBuffer_,  &runBuffer_,   &fault_,      &patchConstantBuffer_,
-            &rootY_,       &cut_,          &patchOut_,    &patchDraw_};
+  std::array<GLuint*, 19> buffers() {
+    return {&position_[0],  &position_[1], &velocity_[0], &velocity_[1], &trample_[0],          &trample_[1], &anchor_,
+            &displacement_, &tickBuffer_,  &runBuffer_,   &fault_,       &patchConstantBuffer_, &rootY_,      &cut_,
+            &patchOut_,     &patchDraw_,   &pushValues_,  &pushInts_,    &pushCounts_};
   }
 
   std::shared_ptr<ComputeContext> context_;
@@ -380,6 +436,14 @@ class GlParticleDevice final : public ParticleDevice<S> {
   bool tramples_ = false;
   std::vector<Raw> tick_;
   std::vector<int32_t> runs_;
+  // The body pushes (packPush): values, integers and per-body counts, each tick that has pushers.
+  GLuint pushValues_ = 0, pushInts_ = 0, pushCounts_ = 0;
+  GLsizeiptr pushValueCapacity_ = 0, pushIntCapacity_ = 0, pushCountCapacity_ = 0;
+  GLint pushPartsLocation_ = -1, pushFlagsLocation_ = -1;
+  GLuint pushFlags_ = 0;
+  std::vector<Raw> pushValueData_;
+  std::vector<int32_t> pushIntData_;
+  std::vector<GLuint> pushCountWords_;
   // The patch stage (derivePatches): per patch slot, the inputs (root height, cut flag as a
   // 32-bit word) copied when their revision changes, and the outputs.
   GLuint patchConstantBuffer_ = 0, rootY_ = 0, cut_ = 0, patchOut_ = 0, patchDraw_ = 0;

@@ -142,9 +142,10 @@ RAW divChecked(RAW a, RAW b) {
   if (m > (negative ? 0x8000000000000000ul : 0x7FFFFFFFFFFFFFFFul)) overflowed = true;
   return negative ? -RAW(m) : RAW(m);
 }
-// length3: isqrtNearest of the exact 128-bit sum of squares (< 3 2^126: no carry out).
-RAW length3(RAW x, RAW y, RAW z) {
-  uint64_t h = 0ul, l = 0ul;
+// x^2 + y^2 + z^2 of the raw values, exactly (< 3 2^126: no carry out of 128 bits).
+void sumOfSquares(RAW x, RAW y, RAW z, out uint64_t h, out uint64_t l) {
+  h = 0ul;
+  l = 0ul;
   RAW v[3] = RAW[3](x, y, z);
   for (int a = 0; a < 3; ++a) {
     uint64_t sh, sl;
@@ -153,6 +154,11 @@ RAW length3(RAW x, RAW y, RAW z) {
     l += sl;
     h += sh + (l < sl ? 1ul : 0ul);
   }
+}
+// length3: isqrtNearest of the exact sum of squares.
+RAW length3(RAW x, RAW y, RAW z) {
+  uint64_t h, l;
+  sumOfSquares(x, y, z, h, l);
   uint64_t r = isqrtFloor128(h, l);
   uint64_t sh, sl, eh, el;
   mul64x64(r, r, sh, sl);
@@ -227,6 +233,274 @@ uniform uint count;
 
 void noteFault(uint key) { atomicMin(faultKey, key); }
 
+// ---- body pushes (sim/collision/body_particles.h), applied before the integration ------------
+// The response stage's push, fused into this pass: per particle the parts over its row, in
+// (body, part) order, each if the particle's column lies in the part's range and the particle
+// within its reach cube; the same escape chain for a particle carried pushAllowance or more. A
+// push that may have faulted faults the pass (key 0): the host then redoes the pushes and the
+// pass from the tick's input, and reports the reference's own fault.
+// [0]: pushAllowance, [1]: rod length (held tips); then per part 17 values: centre (3), rotation
+// row by row (9), half extents (3; a sphere's radius first), share, candidate reach.
+layout(std430, binding = 11) readonly buffer PushValues { RAW pushValue[]; };
+// Per part 4 values: shape (0 sphere, 1 box), body, storage column of its range's first column,
+// columns in the range; then per storage row r, [4 parts + r] and [4 parts + r + 1] bound that
+// row's part list in this array.
+layout(std430, binding = 12) readonly buffer PushInts { int pushInt[]; };
+layout(std430, binding = 13) buffer PushCounts { uint pushCount[]; };  // per body (grass drag)
+uniform uint pushParts;  // parts pushing this tick; 0: no push
+uniform uint pushFlags;  // 1 nearest-face box normal (else up), 2 held tips, 4 grid ranges, 8 count pushes
+
+// The particle under way: position, velocity, anchor, trample level.
+RAW px, py, pz, pu, pv, pw, pax, pay, paz, ptrample;
+
+RAW partValue(int part, int k) { return pushValue[2 + 17 * part + k]; }
+
+#if FLOAT
+RAW absS(RAW a) { return abs(a); }
+RAW sqrtS(RAW a) { return sqrt(a); }
+bool length3AtLeast(RAW x, RAW y, RAW z, RAW r) { return length3(x, y, z) >= r; }
+RAW sum3(RAW a, RAW b, RAW c) { precise RAW bc = b + c; precise RAW r = a + bc; return r; }
+bool movedAtLeast(RAW now, RAW start, RAW limit) { precise RAW d = now - start; return !(abs(d) < limit); }
+#else
+RAW absS(RAW a) { return a < RAW(0) ? subChecked(RAW(0), a) : a; }  // Fixed's abs: -min overflows
+// One row of an Eigen 3 x 3 product: a + (b + c) as Eigen's unrolled sum, the overflow of the other grouping raised
+// too (a false alarm at worst, which only sends the tick to the CPU).
+RAW sum3(RAW a, RAW b, RAW c) { addChecked(addChecked(a, b), c); return addChecked(a, addChecked(b, c)); }
+// movedAtLeast: |now - start| >= limit, a difference that leaves the format counting as moved.
+bool movedAtLeast(RAW now, RAW start, RAW limit) {
+  RAW d = now - start;
+  if (((now ^ start) & (now ^ d)) < RAW(0) || limit <= RAW(0)) return true;
+  uint64_t m = d < RAW(0) ? uint64_t(-int64_t(d)) : uint64_t(int64_t(d));
+  return m >= uint64_t(int64_t(limit));
+}
+#if FX32
+// sqrt: isqrtNearest(raw 2^32), a domain fault for a negative value.
+RAW sqrtS(RAW a) {
+  if (a < 0l) { overflowed = true; return 0l; }
+  uint64_t nh = uint64_t(a) >> 32, nl = uint64_t(a) << 32;
+  uint64_t r = isqrtFloor128(nh, nl);
+  uint64_t sh, sl, eh, el;
+  mul64x64(r, r, sh, sl);
+  difference128(nh, nl, sh, sl, eh, el);
+  if (eh != 0ul || el > r) r += 1ul;
+  return RAW(r);
+}
+// length3(x, y, z) >= r without the root: the exact sum of squares against r^2 - r + 1 (r > 0).
+bool length3AtLeast(RAW x, RAW y, RAW z, RAW r) {
+  uint64_t h, l;
+  sumOfSquares(x, y, z, h, l);
+  uint64_t radius = uint64_t(r), qh, ql;
+  mul64x64(radius, radius, qh, ql);
+  uint64_t d = radius - 1ul;
+  uint64_t th = qh - (ql < d ? 1ul : 0ul), tl = ql - d;
+  return lessOrEqual128(th, tl, h, l);
+}
+#else
+RAW sqrtS(RAW a) {
+  if (a < 0) { overflowed = true; return 0; }
+  uint64_t n = uint64_t(a) << 16;
+  uint64_t r = isqrtFloor128(0ul, n);
+  if (n - r * r > r) r += 1ul;
+  return RAW(uint(r));
+}
+bool length3AtLeast(RAW x, RAW y, RAW z, RAW r) {
+  uint64_t mx = uint64_t(abs(int64_t(x))), my = uint64_t(abs(int64_t(y))), mz = uint64_t(abs(int64_t(z)));
+  uint64_t radius = uint64_t(r);
+  return mx * mx + my * my + mz * mz >= radius * radius - radius + 1ul;
+}
+#endif
+#endif
+
+// pose.rotation * v, and its transpose times v (Pose::toLocal), row by row as Eigen sums them.
+void rotate(int part, RAW v[3], out RAW r[3]) {
+  for (int i = 0; i < 3; ++i)
+    r[i] = sum3(mulChecked(partValue(part, 3 + 3 * i), v[0]), mulChecked(partValue(part, 4 + 3 * i), v[1]),
+                mulChecked(partValue(part, 5 + 3 * i), v[2]));
+}
+void rotateBack(int part, RAW v[3], out RAW r[3]) {
+  for (int i = 0; i < 3; ++i)
+    r[i] = sum3(mulChecked(partValue(part, 3 + i), v[0]), mulChecked(partValue(part, 6 + i), v[1]),
+                mulChecked(partValue(part, 9 + i), v[2]));
+}
+
+// contact.h's nearestFaceAxis: the lowest axis wins ties.
+int nearestFaceAxis(RAW local[3], RAW h[3], out RAW gap, out RAW side) {
+  int axis = 0;
+  gap = subChecked(h[0], absS(local[0]));
+  for (int k = 1; k < 3; ++k) {
+    RAW g = subChecked(h[k], absS(local[k]));
+    if (g < gap) { gap = g; axis = k; }
+  }
+  side = local[axis] < RAW(0) ? RAW(-ONE) : RAW(ONE);
+  return axis;
+}
+
+// reachableFaceAxis: the nearest face the blade can reach out through (exit within `reach` of its root).
+int reachableFaceAxis(int part, RAW local[3], RAW h[3], RAW share, RAW reach, out RAW gap, out RAW side) {
+  int axis = nearestFaceAxis(local, h, gap, side);
+  bool found = false;
+  RAW reachSquared = mulChecked(reach, reach);
+  for (int k = 0; k < 3; ++k)
+    for (int s = 0; s < 2; ++s) {
+      RAW sign = s == 0 ? RAW(-ONE) : RAW(ONE);
+      RAW g = subChecked(h[k], mulChecked(sign, local[k]));
+      if (found && g >= gap) continue;
+      RAW amount = mulChecked(g, share);
+      RAW moved[3], e[3];
+      for (int a = 0; a < 3; ++a) moved[a] = addChecked(local[a], mulChecked(a == k ? sign : RAW(0), amount));
+      rotate(part, moved, e);
+      RAW ex = subChecked(addChecked(partValue(part, 0), e[0]), pax);
+      RAW ey = subChecked(addChecked(partValue(part, 1), e[1]), pay);
+      RAW ez = subChecked(addChecked(partValue(part, 2), e[2]), paz);
+      RAW d2 = addChecked(addChecked(mulChecked(ex, ex), mulChecked(ey, ey)), mulChecked(ez, ez));
+      if (d2 > reachSquared) continue;
+      found = true;
+      axis = k;
+      gap = g;
+      side = sign;
+    }
+  return axis;
+}
+
+// pushOut: whether the particle was inside the part (then it is moved out).
+bool pushOut(int part, RAW reach) {
+  RAW share = partValue(part, 15);
+  RAW d[3] = RAW[3](subChecked(px, partValue(part, 0)), subChecked(py, partValue(part, 1)),
+                    subChecked(pz, partValue(part, 2)));
+  if (pushInt[4 * part] == 0) {  // sphere: out along the normal from the centre
+    RAW radius = partValue(part, 12);
+    if (length3AtLeast(d[0], d[1], d[2], radius)) return false;
+    RAW dist = length3(d[0], d[1], d[2]);
+    RAW nx = RAW(0), ny = RAW(ONE), nz = RAW(0);
+    if (dist != RAW(0)) { nx = divChecked(d[0], dist); ny = divChecked(d[1], dist); nz = divChecked(d[2], dist); }
+    RAW amount = mulChecked(subChecked(radius, dist), share);
+    px = addChecked(px, mulChecked(nx, amount));
+    py = addChecked(py, mulChecked(ny, amount));
+    pz = addChecked(pz, mulChecked(nz, amount));
+    return true;
+  }
+  RAW local[3];
+  rotateBack(part, d, local);
+  RAW h[3] = RAW[3](partValue(part, 12), partValue(part, 13), partValue(part, 14));
+  if (absS(local[0]) >= h[0] || absS(local[1]) >= h[1] || absS(local[2]) >= h[2]) return false;
+  bool nearestFace = (pushFlags & 1u) != 0u;
+  RAW gap, side;
+  int axis = reach > RAW(0) && nearestFace ? reachableFaceAxis(part, local, h, share, reach, gap, side)
+                                           : nearestFaceAxis(local, h, gap, side);
+  RAW amount = mulChecked(gap, share);
+  if (!nearestFace) {  // "up": pressed down, by the smallest face gap
+    py = subChecked(py, amount);
+    return true;
+  }
+  RAW face[3] = RAW[3](RAW(0), RAW(0), RAW(0)), n[3];
+  face[axis] = side;
+  rotate(part, face, n);
+  px = addChecked(px, mulChecked(n[0], amount));
+  py = addChecked(py, mulChecked(n[1], amount));
+  pz = addChecked(pz, mulChecked(n[2], amount));
+  return true;
+}
+
+// Held tips (holdTip and its two cases, body_particles.cpp).
+void bendUnderVerticalPush(RAW centreX, RAW centreZ, RAW rod) {
+  RAW height = subChecked(py, pay);
+  height = height < RAW(0) ? RAW(0) : (rod < height ? rod : height);  // std::clamp
+  RAW leanX = subChecked(px, pax), leanZ = subChecked(pz, paz);
+  RAW lean = length3(leanX, RAW(0), leanZ);
+  if (lean == RAW(0)) {
+    leanX = subChecked(pax, centreX);
+    leanZ = subChecked(paz, centreZ);
+    lean = length3(leanX, RAW(0), leanZ);
+  }
+  if (lean == RAW(0)) {
+    leanX = RAW(ONE);
+    leanZ = RAW(0);
+    lean = RAW(ONE);
+  }
+  RAW reach = divChecked(sqrtS(subChecked(mulChecked(rod, rod), mulChecked(height, height))), lean);
+  px = addChecked(pax, mulChecked(leanX, reach));
+  py = addChecked(pay, height);
+  pz = addChecked(paz, mulChecked(leanZ, reach));
+}
+void backToTheRod(RAW rod) {
+  RAW ex = subChecked(px, pax), ey = py > pay ? subChecked(py, pay) : RAW(0), ez = subChecked(pz, paz);
+  RAW len = length3(ex, ey, ez);
+  if (len == RAW(0)) return;
+  RAW scale = divChecked(rod, len);
+  px = addChecked(pax, mulChecked(ex, scale));
+  py = addChecked(pay, mulChecked(ey, scale));
+  pz = addChecked(paz, mulChecked(ez, scale));
+}
+void holdTip(RAW bx, RAW by, RAW bz, RAW centreX, RAW centreZ, RAW rod) {
+#if TRAMPLE
+  ptrample = RAW(ONE);
+#endif
+  if (px == bx && pz == bz) bendUnderVerticalPush(centreX, centreZ, rod);
+  else backToTheRod(rod);
+  RAW dx = subChecked(px, bx), dy = subChecked(py, by), dz = subChecked(pz, bz);
+  RAW length = length3(dx, dy, dz);
+  if (length == RAW(0)) {  // pinned: held still
+    pu = RAW(0);
+    pv = RAW(0);
+    pw = RAW(0);
+    return;
+  }
+  RAW nx = divChecked(dx, length), ny = divChecked(dy, length), nz = divChecked(dz, length);
+  RAW into = addChecked(addChecked(mulChecked(pu, nx), mulChecked(pv, ny)), mulChecked(pw, nz));
+  if (into >= RAW(0)) return;
+  pu = subChecked(pu, mulChecked(nx, into));
+  pv = subChecked(pv, mulChecked(ny, into));
+  pw = subChecked(pw, mulChecked(nz, into));
+}
+
+bool withinReach(int part) {
+  RAW reach = partValue(part, 16);
+  return !(absS(subChecked(py, partValue(part, 1))) >= reach || absS(subChecked(px, partValue(part, 0))) >= reach ||
+           absS(subChecked(pz, partValue(part, 2))) >= reach);
+}
+
+// pushInside: one part's push and what follows it; false where the stage must stop.
+bool pushInside(int part) {
+  bool hold = (pushFlags & 2u) != 0u;
+  RAW rod = pushValue[1];
+  RAW bx = px, by = py, bz = pz;
+  if (!pushOut(part, hold ? rod : RAW(0))) return true;
+  if ((pushFlags & 8u) != 0u) atomicAdd(pushCount[pushInt[4 * part + 1]], 1u);
+  if (hold) holdTip(bx, by, bz, partValue(part, 0), partValue(part, 2), rod);
+  checkFinite(px, py, pz, pu, pv, pw);
+  return !overflowed;
+}
+
+// Every part over the particle's row, in order (pushParticlesOutOfBodies for one particle).
+void pushParticle(uint row, uint column) {
+  bool ranged = (pushFlags & 4u) != 0u;
+  RAW allowance = pushValue[0];
+  RAW startX = px, startZ = pz;
+  bool movedYet = false;
+  int lists = 4 * int(pushParts);
+  int end = pushInt[lists + int(row) + 1];
+  for (int e = pushInt[lists + int(row)]; e < end; ++e) {
+    int part = pushInt[e];
+    int offset = int(column) - pushInt[4 * part + 2];
+    if (offset < 0) offset += int(countX);
+    if (offset >= pushInt[4 * part + 3] || !withinReach(part)) continue;
+    RAW x = px, z = pz;
+    if (!pushInside(part)) return;
+    if (!ranged || (px == x && pz == z)) continue;
+    if (!movedYet) {  // its first push this tick: where it started
+      movedYet = true;
+      startX = x;
+      startZ = z;
+    }
+    if (!movedAtLeast(px, startX, allowance) && !movedAtLeast(pz, startZ, allowance)) continue;
+    // Carried beyond the ranges' allowance: every later part in order, as brute force meets
+    // them; the row's later parts then pass it by.
+    for (int later = part + 1; later < int(pushParts); ++later)
+      if (withinReach(later) && !pushInside(later)) return;
+    return;
+  }
+}
+
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= count) return;
@@ -247,16 +521,33 @@ void main() {
   uint projectionKey = integrationKey + (pieceEnd - pieceBegin);
   RAW dvx = tickData[8u + 3u * k], dvy = tickData[9u + 3u * k], dvz = tickData[10u + 3u * k];
   uint j = i + count, l = j + count;  // y and z of particle i
-  RAW x = positionIn[i], y = positionIn[j], z = positionIn[l];
-  RAW u = velocityIn[i], v = velocityIn[j], w = velocityIn[l];
-  RAW ax = anchor[i], ay = anchor[j], az = anchor[l];
-  RAW nx, ny, nz;
+  px = positionIn[i];
+  py = positionIn[j];
+  pz = positionIn[l];
+  pu = velocityIn[i];
+  pv = velocityIn[j];
+  pw = velocityIn[l];
+  pax = anchor[i];
+  pay = anchor[j];
+  paz = anchor[l];
+#if TRAMPLE
+  ptrample = trampleIn[i];
+#endif
   overflowed = false;
+  if (pushParts != 0u) {
+    pushParticle(row, column);
+    if (overflowed) noteFault(0u);
+    overflowed = false;
+  }
+  RAW x = px, y = py, z = pz;
+  RAW u = pu, v = pv, w = pw;
+  RAW ax = pax, ay = pay, az = paz;
+  RAW nx, ny, nz;
 #if MODEL == 2
   // blade.h: one loop, every fault the integration's.
   RAW stiffness = tickData[4], damping = tickData[5], decay = tickData[6], invRod = tickData[7];
 #if TRAMPLE
-  RAW trample = trampleIn[i];
+  RAW trample = ptrample;
   stiffness = mulChecked(stiffness, subChecked(RAW(ONE), trample));
   trampleOut[i] = trample > decay ? subChecked(trample, decay) : RAW(0);
 #endif

@@ -86,7 +86,6 @@ void World<S>::moveWindowTo(int64_t originI, int64_t originJ, bool initialVeloci
   };
   fill(grid_.window, oldParticles, [&](int64_t I, int64_t J) { initParticle(I, J, initialVelocity); });
   if (cellsOnly) {
-    flushRowsToDevice();
     thread_local std::vector<typename ParticleDevice<S>::Span> spans;
     spans.clear();
     forEachEnteringSpan(grid_.window, oldParticles, [&](int64_t first, int64_t count) {

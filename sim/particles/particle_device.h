@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/collision/body_particles.h"
 #include "sim/lod/lattice_window.h"
 #include "sim/math/scalar.h"
 #include "sim/particles/particle_kernel.h"
@@ -28,6 +29,21 @@ struct DeviceWind {
   std::vector<int32_t> rowFirstRun;  ///< countZ + 1 entries: row r's runs are [rowFirstRun[r], rowFirstRun[r + 1])
   std::vector<int32_t> runBegin;     ///< per run: the storage column it starts at (it ends where the next begins)
   std::vector<S> dvx, dvy, dvz;      ///< per run (m/s)
+};
+
+/// This tick's body pushes as a device applies them: fused into the particle pass, before the
+/// integration (sim/collision/body_particles.h: per particle the same parts in the same order,
+/// the same escape chain, the same bits). The device reads the pushers' poses, shapes, shares,
+/// column ranges and row buckets, all computed on the host (prepareGrassPushers).
+template <class S>
+struct DevicePush {
+  const GrassPushers<S>* pushers = nullptr;
+  const BodyParticleSettings<S>* settings = nullptr;
+  const LatticeWindow* window = nullptr;  ///< the particle window (storage row -> lattice row)
+  size_t bodyCount = 0;
+  /// Where given (grass drag), each body's pushed particles this tick, summed over the field
+  /// (pushedPerBody's totals); bodyCount entries.
+  std::vector<int64_t>* pushedPerBody = nullptr;
 };
 
 /// What the device's patch stage (patch_state.h) reads besides the particles' tip displacement:
@@ -51,16 +67,16 @@ class ParticleDevice {
   /// Copies the host's particle state (trample levels included) and anchors to the device (the
   /// host is the truth).
   virtual void upload(const ParticleArrays<S>& p) = 0;
-  /// One fused pass over every particle under `wind`. Returns the fault the CPU reference reports
+  /// One fused pass over every particle under `wind`, after `push` (null: no body pushes).
+  /// Returns a fault (particle >= 0) when the pass faulted anywhere: where the fault is the
+  /// integration's or the projection's and no push faulted, the one the CPU reference reports
   /// (the first faulting row's; within a row, run by run in column order, a run's first
   /// integration fault before any projection fault), with the fixed-point fault bits in
-  /// *faultBits. A pass that faults keeps the device's state as it was before the pass (the world
-  /// then redoes the tick on the CPU, which stops at the fault).
-  virtual RowFault advance(const DeviceWind<S>& wind, const ParticleConstants<S>& c, uint32_t* faultBits) = 0;
-  /// Storage rows [rowBegin, rowEnd) of the particle state only (positions, velocities, trample
-  /// levels), each way: the host's body stages push the grass under the bodies (world_device.cpp).
-  virtual void downloadRows(ParticleArrays<S>& p, int64_t rowBegin, int64_t rowEnd) = 0;
-  virtual void uploadRows(const ParticleArrays<S>& p, int64_t rowBegin, int64_t rowEnd) = 0;
+  /// *faultBits; a push that may have faulted reports particle 0. A pass that faults keeps the
+  /// device's state as it was before the pass, pushes included: the world then redoes the tick's
+  /// pushes and pass on the CPU, which stops at the fault and reports its own.
+  virtual RowFault advance(const DeviceWind<S>& wind, const ParticleConstants<S>& c, const DevicePush<S>* push,
+                           uint32_t* faultBits) = 0;
   /// Particles [first, first + count) of each span in storage order, everything of them (state,
   /// anchors, trample levels), host to device: the cells a level-of-detail window move wrote.
   struct Span {

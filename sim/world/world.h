@@ -116,8 +116,9 @@ class World final : public SimWorld {
   bool collisionStage();
   bool integrateStage();
   bool patchStage();
-  /// The integrate stage's particle pass on the device (physics path Gpu or GpuReadback); false
-  /// when it faulted, with the tick's input back on the host for the CPU reference to redo.
+  /// The integrate stage's particle pass on the device (physics path Gpu or GpuReadback), with the
+  /// response stage's grass push where it left one (devicePushPending_); false when it faulted,
+  /// with the tick's input (before the push) back on the host for the CPU reference to redo.
   bool deviceParticlePass();
   /// Why this world's grass stages cannot run on a device ("" when they can).
   std::string deviceLimitation() const;
@@ -125,11 +126,12 @@ class World final : public SimWorld {
   /// patches from them (the patch stage the device path left to this point). Const: it changes
   /// no state, only where the state is held.
   void syncFromDevice() const;
-  /// Before the host pushes the grass under the bodies: copies the rows the pushers span back from
-  /// the device and marks them for the upload after the push.
-  void bringPushedRowsToHost(const GrassPushers<S>& pushers);
-  /// Uploads the rows in hostRowsAhead_.
-  void flushRowsToDevice();
+  /// The grass pushed out of every body on the host (particle rows in parallel, bodies in id
+  /// order), then the grass drag on the bodies; false after recording a fault (Stage::Response).
+  bool pushGrassOnHost(const GrassPushers<S>& pushers);
+  /// The grass drag: each body slowed by the tufts it pushed this tick (per body, summed over the
+  /// field); false after recording a fault (Stage::Response).
+  bool applyGrassDrag(const std::vector<int64_t>& pushedPerBody);
   /// Records a fixed-point fault of `stage` as the world's failure; returns false.
   bool failWith(Stage stage, uint32_t faults);
   template <class Fn>
@@ -220,9 +222,12 @@ class World final : public SimWorld {
   PhysicsPath physicsPath_ = PhysicsPath::Cpu;
   std::unique_ptr<ParticleDevice<S>> device_;
   DeviceWind<S> deviceWind_;  ///< the tick's wind as the device reads it (scratch, not state)
-  /// Storage row ranges the host's grass push changed since the device's last copy (uploaded
-  /// before the next pass or download).
-  std::vector<std::pair<int64_t, int64_t>> hostRowsAhead_;
+  /// The grass push of the response stage, left to the device's particle pass (which applies it
+  /// before the integration, in the same order, with the same bits; the host redoes both where
+  /// the pass faults). Scratch of one tick, not state.
+  GrassPushers<S> devicePushers_;
+  bool devicePushPending_ = false;
+  std::vector<int64_t> devicePushedPerBody_;
   bool deviceAhead_ = false;
   bool hostAhead_ = false;
   /// The device's tip displacements are the current state's (a pass on the `gpu` path since the

@@ -22,7 +22,6 @@ std::string World<S>::setPhysicsPath(PhysicsPath path, ParticleDeviceProvider* p
   if (path == PhysicsPath::Cpu) {
     syncFromDevice();
     device_.reset();
-    hostRowsAhead_.clear();
     physicsPath_ = path;
     return "";
   }
@@ -55,9 +54,7 @@ bool World<S>::deviceParticlePass() {
   if (hostAhead_) {
     device_->upload(particles_);
     hostAhead_ = false;
-    hostRowsAhead_.clear();
   }
-  flushRowsToDevice();
   // The wind as runs of columns, row by row (a few values per row; computed here on the host as
   // the CPU pass computes it). Without a window, storage rows and columns are lattice ones.
   DeviceWind<S>& wind = deviceWind_;
@@ -104,8 +101,21 @@ bool World<S>::deviceParticlePass() {
     return false;
   };
   if (pendingFixedFaults() != 0) return handBack();
+  // The response stage's grass push (respondToContacts), applied by the pass before it
+  // integrates; each body's pushed tufts come back only where the grass drags the bodies.
+  DevicePush<S> push;
+  if (devicePushPending_) {
+    push.pushers = &devicePushers_;
+    push.settings = &bodyParticle_;
+    push.window = &grid_.window;
+    push.bodyCount = bodies_.size();
+    if (grassDragDt_ > S(0)) {
+      devicePushedPerBody_.assign(bodies_.size(), 0);
+      push.pushedPerBody = &devicePushedPerBody_;
+    }
+  }
   uint32_t faultBits = 0;
-  const RowFault fault = device_->advance(wind, particleConsts_, &faultBits);
+  const RowFault fault = device_->advance(wind, particleConsts_, devicePushPending_ ? &push : nullptr, &faultBits);
   if (fault.particle >= 0) return handBack();
   deviceAhead_ = true;
   deviceDisplacementCurrent_ = physicsPath_ == PhysicsPath::Gpu;
@@ -136,38 +146,11 @@ bool World<S>::downloadDevicePatches(PatchArrays<S>* out) const {
 }
 
 template <class S>
-void World<S>::bringPushedRowsToHost(const GrassPushers<S>& pushers) {
-  // The rows any pusher spans (pushParticlesOutOfBodies skips the others), as ranges.
-  for (int64_t row = 0; row < grid_.countZ;) {
-    const auto spanned = [&](int64_t r) {
-      const int64_t b = grid_.window.latticeRow(r) - pushers.originJ;
-      return pushers.rowStart[size_t(b + 1)] > pushers.rowStart[size_t(b)];
-    };
-    if (!spanned(row)) {
-      ++row;
-      continue;
-    }
-    int64_t end = row + 1;
-    while (end < grid_.countZ && spanned(end)) ++end;
-    if (deviceAhead_) device_->downloadRows(particles_, row, end);
-    hostRowsAhead_.emplace_back(row, end);
-    row = end;
-  }
-}
-
-template <class S>
-void World<S>::flushRowsToDevice() {
-  for (const auto& [begin, end] : hostRowsAhead_) device_->uploadRows(particles_, begin, end);
-  hostRowsAhead_.clear();
-}
-
-template <class S>
 void World<S>::syncFromDevice() const {
   if (!deviceAhead_) return;
   // Worlds are never const objects (makeWorld builds them on the heap): const here means "the
   // state does not change", which holds; only where it is held does.
   auto* self = const_cast<World<S>*>(this);
-  self->flushRowsToDevice();  // rows the host pushed after the device's pass (a fault stopped the tick)
   self->device_->download(self->particles_, &self->dispX_, &self->dispY_, &self->dispZ_);
   self->deviceAhead_ = false;
   self->updatePatchesFromDisplacement();  // the patch stage the device path left to here
@@ -179,9 +162,7 @@ void World<S>::syncFromDevice() const {
   template bool World<S>::deviceParticlePass();                                        \
   template bool World<S>::downloadDevicePatches(PatchArrays<S>*) const;                \
   template bool World<S>::deriveDevicePatches() const;                                 \
-  template void World<S>::syncFromDevice() const;                                      \
-  template void World<S>::bringPushedRowsToHost(const GrassPushers<S>&);               \
-  template void World<S>::flushRowsToDevice();
+  template void World<S>::syncFromDevice() const;
 
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE_DEVICE)
 
