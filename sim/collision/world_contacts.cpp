@@ -140,8 +140,8 @@ bool World<S>::respondToContacts() {
   sweepFastBodiesAgainstTerrain(bodies_, start, terrain_, solver_.linearSlop);
   if (bodiesFaulted(Stage::Response)) return false;
   mowGrass();
-  // Grass: pushed out of every body. On a device the particle pass applies the push before it
-  // integrates (world_device.cpp): the particles stay there.
+  // Grass: pushed out of every body. On a device the push runs there, just before the particle
+  // pass (world_device.cpp): the particles stay on the device.
   GrassPushers<S> pushers = prepareGrassPushers(bodies_, grid_, bodyParticle_);
   if (device_) {
     devicePushers_ = std::move(pushers);

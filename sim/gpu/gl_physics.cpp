@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <functional>
 #include <type_traits>
 
 #include "sim/gpu/particle_pass_glsl.h"
@@ -73,7 +74,17 @@ enum Binding : GLuint {
   kFault,
   kRuns,
   kTrampleIn,
-  kTrampleOut,
+  kTrampleOut
+};
+// The push pass's bindings (kPushPassGlsl).
+enum PushBinding : GLuint {
+  kPushPosition,
+  kPushVelocity,
+  kPushAnchor,
+  kPushTrample,
+  kPushFault,
+  kPushCandidates,
+  kPushBackup,
   kPushValues,
   kPushInts,
   kPushCounts
@@ -105,10 +116,12 @@ class GlParticleDevice final : public ParticleDevice<S> {
   static_assert(sizeof(S) == sizeof(Raw) && std::is_trivially_copyable_v<S>, "a value is stored as itself");
 
  public:
-  GlParticleDevice(std::shared_ptr<ComputeContext> context, GLuint program, GLuint patchProgram, int64_t countX,
-                   int64_t countZ, bool tramples)
+  /// `pushProgram` compiles (once, kept by the provider) the bodies' push pass.
+  GlParticleDevice(std::shared_ptr<ComputeContext> context, GLuint program, std::function<GLuint()> pushProgram,
+                   GLuint patchProgram, int64_t countX, int64_t countZ, bool tramples)
       : context_(std::move(context)),
         program_(program),
+        makePushProgram_(std::move(pushProgram)),
         patchProgram_(patchProgram),
         countX_(countX),
         countZ_(countZ),
@@ -117,13 +130,9 @@ class GlParticleDevice final : public ParticleDevice<S> {
     for (GLuint b : {position_[0], position_[1], velocity_[0], velocity_[1], anchor_, displacement_})
       glNamedBufferData(b, 3 * arrayBytes(), nullptr, GL_DYNAMIC_COPY);
     for (GLuint b : trample_) glNamedBufferData(b, tramples ? arrayBytes() : 16, nullptr, GL_DYNAMIC_COPY);
-    for (GLuint b : {pushValues_, pushInts_, pushCounts_}) glNamedBufferData(b, 16, nullptr, GL_STREAM_DRAW);
+    for (GLuint b : {pushValues_, pushInts_, pushCounts_, candidates_, backup_})
+      glNamedBufferData(b, 16, nullptr, GL_STREAM_DRAW);
     glNamedBufferData(fault_, sizeof(GLuint), nullptr, GL_STREAM_READ);
-    countXLocation_ = glGetUniformLocation(program_, "countX");
-    countZLocation_ = glGetUniformLocation(program_, "countZ");
-    countLocation_ = glGetUniformLocation(program_, "count");
-    pushPartsLocation_ = glGetUniformLocation(program_, "pushParts");
-    pushFlagsLocation_ = glGetUniformLocation(program_, "pushFlags");
   }
   ~GlParticleDevice() override {  // the program is the provider's
     context_->makeCurrent();
@@ -168,7 +177,14 @@ class GlParticleDevice final : public ParticleDevice<S> {
     const GLuint none = 0xFFFFFFFFu;
     glNamedBufferSubData(fault_, 0, sizeof none, &none);
     traffic_.toDevice += GLsizeiptr(tick_.size() * sizeof(Raw) + runs_.size() * sizeof(int32_t) + sizeof none);
+    // The bodies' push first, in place on the current state, over the candidates only.
     const GLuint pushParts = push ? packPush(*push) : 0;
+    if (pushParts > 0 && !pushProgram_) pushProgram_ = makePushProgram_();
+    if (pushParts > 0 && !pushProgram_) {  // it did not compile: the CPU does the tick (GlPhysicsProvider::make)
+      *faultBits = 0;
+      return {0, Stage::Integrate};
+    }
+    if (pushParts > 0) runPushPass(pushParts, false);
     glUseProgram(program_);
     const GLuint next = 1 - current_;
     const std::pair<Binding, GLuint> bindings[] = {{kPositionIn, position_[current_]},
@@ -181,17 +197,12 @@ class GlParticleDevice final : public ParticleDevice<S> {
                                                    {kFault, fault_},
                                                    {kRuns, runBuffer_},
                                                    {kTrampleIn, trample_[current_]},
-                                                   {kTrampleOut, trample_[next]},
-                                                   {kPushValues, pushValues_},
-                                                   {kPushInts, pushInts_},
-                                                   {kPushCounts, pushCounts_}};
+                                                   {kTrampleOut, trample_[next]}};
     for (const auto& [binding, buffer] : bindings) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer);
     const int64_t n = countX_ * countZ_;
-    glUniform1ui(countXLocation_, GLuint(countX_));
-    glUniform1ui(countZLocation_, GLuint(countZ_));
-    glUniform1ui(countLocation_, GLuint(n));
-    glUniform1ui(pushPartsLocation_, pushParts);
-    glUniform1ui(pushFlagsLocation_, pushFlags_);
+    glUniform1ui(glGetUniformLocation(program_, "countX"), GLuint(countX_));
+    glUniform1ui(glGetUniformLocation(program_, "countZ"), GLuint(countZ_));
+    glUniform1ui(glGetUniformLocation(program_, "count"), GLuint(n));
     glDispatchCompute(GLuint((n + 255) / 256), 1, 1);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     // The one value every tick reads back: whether (and where) the pass faulted, which step()
@@ -210,8 +221,11 @@ class GlParticleDevice final : public ParticleDevice<S> {
       current_ = next;
       return {};
     }
+    // The tick's input back where the push changed it, for the CPU reference to redo the tick.
+    if (pushParts > 0) runPushPass(pushParts, true);
     // The only fixed-point fault the pass can raise (no d = 0 division, no negative root); a float
-    // pass faults on a non-finite value, which has no fault bits.
+    // pass faults on a non-finite value, which has no fault bits. A push's (key 0) is reported as
+    // the first particle's: the reference redoes the tick and reports its own.
     *faultBits = std::is_same_v<S, float> ? 0u : uint32_t(kFixedFaultOverflow);
     return decode(key, wind);
   }
@@ -348,9 +362,37 @@ class GlParticleDevice final : public ParticleDevice<S> {
     }
     glNamedBufferSubData(buffer, 0, bytes, values.data());
   }
-  /// Packs this tick's pushers for the pass (particle_pass_glsl.h, "body pushes") into the push
-  /// buffers, clears the per-body counts where they are kept, sets pushFlags_; returns the number
-  /// of parts (0: nothing to push).
+  /// The push pass over this tick's candidates (packPush), or, with `restore`, the candidates'
+  /// state put back as the push found it.
+  void runPushPass(GLuint pushParts, bool restore) {
+    const GLuint p = pushProgram_;
+    glUseProgram(p);
+    const std::pair<PushBinding, GLuint> bindings[] = {{kPushPosition, position_[current_]},
+                                                       {kPushVelocity, velocity_[current_]},
+                                                       {kPushAnchor, anchor_},
+                                                       {kPushTrample, trample_[current_]},
+                                                       {kPushFault, fault_},
+                                                       {kPushCandidates, candidates_},
+                                                       {kPushBackup, backup_},
+                                                       {kPushValues, pushValues_},
+                                                       {kPushInts, pushInts_},
+                                                       {kPushCounts, pushCounts_}};
+    for (const auto& [binding, buffer] : bindings) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer);
+    const GLuint count = GLuint(candidateList_.size());
+    glUniform1ui(glGetUniformLocation(p, "countX"), GLuint(countX_));
+    glUniform1ui(glGetUniformLocation(p, "count"), GLuint(countX_ * countZ_));
+    glUniform1ui(glGetUniformLocation(p, "candidates"), count);
+    glUniform1ui(glGetUniformLocation(p, "restore"), restore ? 1u : 0u);
+    glUniform1ui(glGetUniformLocation(p, "pushParts"), pushParts);
+    glUniform1ui(glGetUniformLocation(p, "pushFlags"), pushFlags_);
+    glDispatchCompute((count + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+  }
+
+  /// Packs this tick's pushers for the push pass (kPushPassGlsl) into the push buffers, with the
+  /// candidates (each storage row's particles in a column range of a part over it, in row and
+  /// column order), clears the per-body counts where they are kept and sets pushFlags_; returns
+  /// the number of parts (0: nothing to push).
   GLuint packPush(const DevicePush<S>& push) {
     const GrassPushers<S>& pushers = *push.pushers;
     const BodyParticleSettings<S>& settings = *push.settings;
@@ -372,16 +414,38 @@ class GlParticleDevice final : public ParticleDevice<S> {
       pushIntData_.insert(pushIntData_.end(), {sphere ? 0 : 1, p.body, int32_t(p.firstColumn),
                                                int32_t(std::max<int64_t>(0, p.range.a1 - p.range.a0 + 1))});
     }
-    // Each storage row's part list (the bucket of its lattice row), after the row bounds.
+    // Each storage row's part list (the bucket of its lattice row), after the row bounds; and the
+    // row's candidates, the union of its parts' column ranges.
     const size_t lists = pushIntData_.size();
     pushIntData_.resize(lists + size_t(countZ_) + 1);
+    candidateList_.clear();
+    columnTaken_.assign(size_t(countX_), 0);
     for (int64_t r = 0; r < countZ_; ++r) {
       pushIntData_[lists + size_t(r)] = int32_t(pushIntData_.size());
       const int64_t b = push.window->latticeRow(r) - pushers.originJ;
-      for (int64_t k = pushers.rowStart[size_t(b)]; k < pushers.rowStart[size_t(b + 1)]; ++k)
+      const size_t firstCandidate = candidateList_.size();
+      for (int64_t k = pushers.rowStart[size_t(b)]; k < pushers.rowStart[size_t(b + 1)]; ++k) {
+        const GrassPusher<S>& part = pushers.parts[size_t(pushers.byRow[size_t(k)])];
         pushIntData_.push_back(pushers.byRow[size_t(k)]);
+        const int64_t columns = std::min(countX_, part.range.a1 - part.range.a0 + 1);
+        for (int64_t t = 0, c = part.firstColumn; t < columns; ++t, c = c + 1 == countX_ ? 0 : c + 1)
+          if (!columnTaken_[size_t(c)]) {
+            columnTaken_[size_t(c)] = 1;
+            candidateList_.push_back(GLuint(r * countX_ + c));
+          }
+      }
+      std::sort(candidateList_.begin() + std::ptrdiff_t(firstCandidate), candidateList_.end());
+      for (size_t q = firstCandidate; q < candidateList_.size(); ++q) columnTaken_[candidateList_[q] % countX_] = 0;
     }
     pushIntData_[lists + size_t(countZ_)] = int32_t(pushIntData_.size());
+    if (candidateList_.empty()) return 0;
+    replaceContents(candidates_, candidateList_, &candidateCapacity_);
+    const GLsizeiptr backupBytes = GLsizeiptr(7 * candidateList_.size() * sizeof(Raw));
+    if (backupBytes > backupCapacity_) {
+      backupCapacity_ = std::max(backupBytes, 2 * backupCapacity_);
+      glNamedBufferData(backup_, backupCapacity_, nullptr, GL_DYNAMIC_COPY);
+    }
+    traffic_.toDevice += GLsizeiptr(candidateList_.size() * sizeof(GLuint));
     replaceContents(pushValues_, pushValueData_, &pushValueCapacity_);
     replaceContents(pushInts_, pushIntData_, &pushIntCapacity_);
     traffic_.toDevice += GLsizeiptr(pushValueData_.size() * sizeof(Raw) + pushIntData_.size() * sizeof(int32_t));
@@ -417,29 +481,33 @@ class GlParticleDevice final : public ParticleDevice<S> {
     return {row * countX_, Stage::Integrate};  // unreachable: the runs cover the row
   }
 
-  std::array<GLuint*, 19> buffers() {
+  std::array<GLuint*, 21> buffers() {
     return {&position_[0],  &position_[1], &velocity_[0], &velocity_[1], &trample_[0],          &trample_[1], &anchor_,
             &displacement_, &tickBuffer_,  &runBuffer_,   &fault_,       &patchConstantBuffer_, &rootY_,      &cut_,
-            &patchOut_,     &patchDraw_,   &pushValues_,  &pushInts_,    &pushCounts_};
+            &patchOut_,     &patchDraw_,   &pushValues_,  &pushInts_,    &pushCounts_,          &candidates_, &backup_};
   }
 
   std::shared_ptr<ComputeContext> context_;
-  GLuint program_ = 0, patchProgram_ = 0;
+  GLuint program_ = 0;
+  std::function<GLuint()> makePushProgram_;
+  GLuint patchProgram_ = 0, pushProgram_ = 0;
   GLuint position_[2] = {}, velocity_[2] = {};  ///< x, y and z in each
   GLuint trample_[2] = {};                      ///< 16 bytes each without trampling
   GLuint anchor_ = 0, displacement_ = 0;        ///< x, y and z in each
   GLuint tickBuffer_ = 0, runBuffer_ = 0, fault_ = 0;
   GLsizeiptr tickCapacity_ = 0, runCapacity_ = 0;
   GLuint current_ = 0;  ///< which position, velocity and trample set holds the state
-  GLint countXLocation_ = -1, countZLocation_ = -1, countLocation_ = -1;
   int64_t countX_ = 0, countZ_ = 0;
   bool tramples_ = false;
   std::vector<Raw> tick_;
   std::vector<int32_t> runs_;
-  // The body pushes (packPush): values, integers and per-body counts, each tick that has pushers.
-  GLuint pushValues_ = 0, pushInts_ = 0, pushCounts_ = 0;
-  GLsizeiptr pushValueCapacity_ = 0, pushIntCapacity_ = 0, pushCountCapacity_ = 0;
-  GLint pushPartsLocation_ = -1, pushFlagsLocation_ = -1;
+  // The body pushes (packPush): values, integers, candidates, the candidates' state before the
+  // push, and per-body counts, each tick that has pushers.
+  GLuint pushValues_ = 0, pushInts_ = 0, pushCounts_ = 0, candidates_ = 0, backup_ = 0;
+  GLsizeiptr pushValueCapacity_ = 0, pushIntCapacity_ = 0, pushCountCapacity_ = 0, candidateCapacity_ = 0,
+             backupCapacity_ = 0;
+  std::vector<GLuint> candidateList_;
+  std::vector<uint8_t> columnTaken_;
   GLuint pushFlags_ = 0;
   std::vector<Raw> pushValueData_;
   std::vector<int32_t> pushIntData_;
@@ -463,8 +531,9 @@ class GlPhysicsProvider final : public ParticleDeviceProvider {
     context_->makeCurrent();
     for (auto& byModel : programs_)
       for (auto& byTrample : byModel)
-        for (GLuint p : byTrample)
-          if (p) glDeleteProgram(p);
+        for (auto& byPush : byTrample)
+          for (GLuint p : byPush)
+            if (p) glDeleteProgram(p);
     for (GLuint p : patchPrograms_)
       if (p) glDeleteProgram(p);
   }
@@ -501,15 +570,24 @@ class GlPhysicsProvider final : public ParticleDeviceProvider {
     const int modelIndex = model == GrassModel::Pbd ? 1 : model == GrassModel::Blade ? 2 : 0;
     tramples = tramples && model == GrassModel::Blade;
     const int format = std::is_same_v<S, Fx32> ? 0 : std::is_same_v<S, Fx16> ? 1 : 2;
-    GLuint& program = programs_[format][modelIndex][tramples ? 1 : 0];
+    GLuint(&programs)[2] = programs_[format][modelIndex][tramples ? 1 : 0];
     const std::string prelude = std::string("#version 450\n#extension GL_ARB_gpu_shader_int64 : require\n") +
                                 "#define FX32 " + (format == 0 ? "1" : "0") + "\n#define FLOAT " +
                                 (format == 2 ? "1" : "0") + "\n#define MODEL " + std::to_string(modelIndex) +
                                 "\n#define TRAMPLE " + (tramples ? "1" : "0") + "\n";
-    if (!program) {
-      program = buildProgram(prelude + kScalarGlsl + kParticlePassGlsl, error);
-      if (!program) return nullptr;
+    if (!programs[0]) {
+      programs[0] = buildProgram(prelude + kScalarGlsl + kParticlePassGlsl, error);
+      if (!programs[0]) return nullptr;
     }
+    // The push pass, compiled when a tick first has pushers. A driver that cannot
+    // compile it (none known) leaves the device's advance() reporting a fault at every tick with
+    // pushers, so the CPU reference does those ticks: slow, never wrong.
+    auto pushProgram = [context = context_, &cached = programs[1], source = prelude + kScalarGlsl + kPushPassGlsl]() {
+      context->makeCurrent();
+      std::string ignored;
+      if (!cached) cached = buildProgram(source, &ignored);
+      return cached;
+    };
     GLuint& patchProgram = patchPrograms_[format];
     if (!patchProgram) {
       patchProgram = buildProgram(prelude + kScalarGlsl + kPatchPassGlsl, error);
@@ -517,7 +595,8 @@ class GlPhysicsProvider final : public ParticleDeviceProvider {
     }
     while (glGetError() != GL_NO_ERROR) {
     }
-    auto device = std::make_unique<GlParticleDevice<S>>(context_, program, patchProgram, countX, countZ, tramples);
+    auto device = std::make_unique<GlParticleDevice<S>>(context_, programs[0], std::move(pushProgram), patchProgram,
+                                                        countX, countZ, tramples);
     if (!device->ok()) {
       *error = "GPU physics: the device could not allocate buffers for " + std::to_string(n) + " particles";
       return nullptr;
@@ -526,8 +605,8 @@ class GlPhysicsProvider final : public ParticleDeviceProvider {
   }
 
   std::shared_ptr<ComputeContext> context_;
-  GLuint programs_[3][3][2] = {};  ///< [fx32, fx16, float][thesis, pbd, blade][trample]
-  GLuint patchPrograms_[3] = {};   ///< [fx32, fx16, float]
+  GLuint programs_[3][3][2][2] = {};  ///< [fx32, fx16, float][thesis, pbd, blade][trample][particle, push pass]
+  GLuint patchPrograms_[3] = {};      ///< [fx32, fx16, float]
 };
 
 /// A provider over `context` once it is current, or nullptr when it lacks what the passes need.

@@ -1,12 +1,12 @@
-// The fused particle pass (sim/particles/particle_row.h) and the patch stage
-// (sim/patches/patch_state.h) as OpenGL 4.3 compute shaders, one invocation per particle or
-// patch, in the fixed-point formats' exact integer arithmetic (GL_ARB_gpu_shader_int64). Each operation gives
-// sim/math/fixed.h's bits and raises the same overflow: sums wrap and are checked by sign; products round to nearest,
-// ties away from zero, Q32.32's 128-bit product built from 32 x 32 -> 64 partial products; L / |d| and |d| are guessed
-// in double precision and then settled in exact integer arithmetic (the guess only decides how
-// many correction steps run, never the result). The prelude gl_physics.cpp puts before this text
-// defines FLOAT (1: float, the comparison variant), FX32 (1: Q32.32; both 0: Q16.16), MODEL
-// (0 thesis, 1 pbd, 2 blade) and TRAMPLE (0 or 1).
+// The fused particle pass (sim/particles/particle_row.h), the bodies' push on the grass
+// (sim/collision/body_particles.h) and the patch stage (sim/patches/patch_state.h) as OpenGL 4.3
+// compute shaders, one invocation per particle, candidate particle or patch, in the fixed-point formats' exact integer
+// arithmetic (GL_ARB_gpu_shader_int64). Each operation gives sim/math/fixed.h's bits and raises the same overflow: sums
+// wrap and are checked by sign; products round to nearest, ties away from zero, Q32.32's 128-bit product built from 32
+// x 32 -> 64 partial products; L / |d| and |d| are guessed in double precision and then settled in exact integer
+// arithmetic (the guess only decides how many correction steps run, never the result). The prelude gl_physics.cpp puts
+// before this text defines FLOAT (1: float, the comparison variant), FX32 (1: Q32.32; both 0: Q16.16), MODEL (0 thesis,
+// 1 pbd, 2 blade) and TRAMPLE (0 or 1).
 #pragma once
 
 namespace sg::gpu {
@@ -233,25 +233,161 @@ uniform uint count;
 
 void noteFault(uint key) { atomicMin(faultKey, key); }
 
-// ---- body pushes (sim/collision/body_particles.h), applied before the integration ------------
-// The response stage's push, fused into this pass: per particle the parts over its row, in
-// (body, part) order, each if the particle's column lies in the part's range and the particle
-// within its reach cube; the same escape chain for a particle carried pushAllowance or more. A
-// push that may have faulted faults the pass (key 0): the host then redoes the pushes and the
-// pass from the tick's input, and reports the reference's own fault.
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= count) return;
+  uint row = i / countX, column = i - row * countX;
+  RAW dt = tickData[0], rod = tickData[2], invDt = tickData[3];
+  // The run of this row whose columns hold this particle: the CPU advances a row run by run, in
+  // column order, so its fault order is (row, run, stage, column). The key below orders the same
+  // way: run k of the row covers keys [2 begin_k, 2 end_k) after the row's base.
+  // (Each run's end is stored beside its begin. Read instead as `k + 1 < endRun ? <the next run's
+  // begin> : countX`, it came out 0 for a row's first run on llvmpipe (Mesa 22.3.6), though the
+  // loop above had just read the same element as non-zero; tests/gpu_physics_test.cpp's
+  // properties found it.)
+  uint endRun = runs[row + 1u], k = runs[row];
+  while (k + 1u < endRun && runs[countZ + 1u + 2u * (k + 1u)] <= column) ++k;
+  uint pieceBegin = runs[countZ + 1u + 2u * k];
+  uint pieceEnd = runs[countZ + 2u + 2u * k];
+  uint integrationKey = row * 2u * countX + 2u * pieceBegin + (column - pieceBegin);
+  uint projectionKey = integrationKey + (pieceEnd - pieceBegin);
+  RAW dvx = tickData[8u + 3u * k], dvy = tickData[9u + 3u * k], dvz = tickData[10u + 3u * k];
+  uint j = i + count, l = j + count;  // y and z of particle i
+  RAW x = positionIn[i], y = positionIn[j], z = positionIn[l];
+  RAW u = velocityIn[i], v = velocityIn[j], w = velocityIn[l];
+  RAW ax = anchor[i], ay = anchor[j], az = anchor[l];
+  RAW nx, ny, nz;
+  overflowed = false;
+#if MODEL == 2
+  // blade.h: one loop, every fault the integration's.
+  RAW stiffness = tickData[4], damping = tickData[5], decay = tickData[6], invRod = tickData[7];
+#if TRAMPLE
+  RAW trample = trampleIn[i];
+  stiffness = mulChecked(stiffness, subChecked(RAW(ONE), trample));
+  trampleOut[i] = trample > decay ? subChecked(trample, decay) : RAW(0);
+#endif
+  RAW rx = subChecked(x, ax), ry = subChecked(y, ay), rz = subChecked(z, az);
+  RAW gx = subChecked(dvx, mulChecked(stiffness, rx));
+  RAW gy = subChecked(dvy, mulChecked(stiffness, subChecked(ry, rod)));
+  RAW gz = subChecked(dvz, mulChecked(stiffness, rz));
+  RAW along = mulChecked(
+      mulChecked(addChecked(addChecked(mulChecked(gx, rx), mulChecked(gy, ry)), mulChecked(gz, rz)), invRod), invRod);
+  gx = subChecked(gx, mulChecked(rx, along));
+  gy = subChecked(gy, mulChecked(ry, along));
+  gz = subChecked(gz, mulChecked(rz, along));
+  u = mulChecked(addChecked(u, gx), damping);
+  v = mulChecked(addChecked(v, gy), damping);
+  w = mulChecked(addChecked(w, gz), damping);
+  RAW predictedX = addChecked(x, mulChecked(u, dt)), predictedY = addChecked(y, mulChecked(v, dt)),
+      predictedZ = addChecked(z, mulChecked(w, dt));
+  RAW ex = subChecked(predictedX, ax), ey = predictedY > ay ? subChecked(predictedY, ay) : RAW(0),
+      ez = subChecked(predictedZ, az);
+  RAW len = length3(ex, ey, ez);
+  nx = ax;
+  ny = addChecked(ay, rod);  // computed whether or not it is used, as the reference does
+  nz = az;
+  if (len != RAW(0)) {
+    RAW scale = divChecked(rod, len);
+    nx = addChecked(ax, mulChecked(ex, scale));
+    ny = addChecked(ay, mulChecked(ey, scale));
+    nz = addChecked(az, mulChecked(ez, scale));
+  }
+  u = addChecked(u, mulChecked(subChecked(nx, predictedX), invDt));
+  v = addChecked(v, mulChecked(subChecked(ny, predictedY), invDt));
+  w = addChecked(w, mulChecked(subChecked(nz, predictedZ), invDt));
+  checkFinite(nx, ny, nz, u, v, w);
+  if (overflowed) noteFault(integrationKey);
+#else
+  RAW damping = tickData[1];
+  // Stage 3, integrate.h: explicit order for "thesis", symplectic for "pbd".
+#if MODEL == 0
+  x = addChecked(x, mulChecked(u, dt));
+  y = addChecked(y, mulChecked(v, dt));
+  z = addChecked(z, mulChecked(w, dt));
+#endif
+  u = mulChecked(addChecked(u, dvx), damping);
+  v = mulChecked(addChecked(v, dvy), damping);
+  w = mulChecked(addChecked(w, dvz), damping);
+#if MODEL == 1
+  x = addChecked(x, mulChecked(u, dt));
+  y = addChecked(y, mulChecked(v, dt));
+  z = addChecked(z, mulChecked(w, dt));
+#endif
+  checkFinite(x, y, z, u, v, w);
+  if (overflowed) noteFault(integrationKey);
+
+  // Stage 4, rod_constraint.h.
+  overflowed = false;
+  RAW dx = subChecked(x, ax), dy = subChecked(y, ay), dz = subChecked(z, az);
+  RAW len = length3(dx, dy, dz);
+  if (len == RAW(0)) {
+    nx = ax;
+    ny = addChecked(ay, rod);
+    nz = az;
+  } else {
+    RAW scale = divChecked(rod, len);
+    nx = addChecked(ax, mulChecked(dx, scale));
+    ny = addChecked(ay, mulChecked(dy, scale));
+    nz = addChecked(az, mulChecked(dz, scale));
+  }
+#if MODEL == 1
+  u = addChecked(u, mulChecked(subChecked(nx, x), invDt));
+  v = addChecked(v, mulChecked(subChecked(ny, y), invDt));
+  w = addChecked(w, mulChecked(subChecked(nz, z), invDt));
+#endif
+  checkFinite(nx, ny, nz, u, v, w);
+  if (overflowed) noteFault(projectionKey);
+#endif
+
+  positionOut[i] = nx; positionOut[j] = ny; positionOut[l] = nz;
+  velocityOut[i] = u; velocityOut[j] = v; velocityOut[l] = w;
+  // The tip displacement the patch stage reads (patch_state.h): unchecked, wrapping.
+  displacement[i] = nx - ax;
+  displacement[j] = ny - ay - rod;
+  displacement[l] = nz - az;
+}
+)GLSL";
+
+/// The bodies' push on the grass (sim/collision/body_particles.h) as a compute shader, one
+/// invocation per candidate particle: those whose storage row has parts over it and whose column
+/// lies in one of their ranges (a list the host builds from the pushers, without positions). Per
+/// particle the parts over its row, in (body, part) order, each where the particle lies in its
+/// range and reach cube, with the same operations and the same escape chain as
+/// pushParticlesOutOfBodies. It runs before the particle pass, in place on the current state, and
+/// keeps each candidate's state as it found it (backup), so a tick that faults, in the push or the
+/// pass, can put the tick's input back (`restore`): the host then redoes the tick. A push that
+/// faults, or may have, offers fault key 0. Put after kScalarGlsl.
+inline constexpr const char* kPushPassGlsl = R"GLSL(
+layout(local_size_x = 64) in;
+
+layout(std430, binding = 0) buffer Position { RAW position[]; };  // x, y, z arrays of `count`
+layout(std430, binding = 1) buffer Velocity { RAW velocity[]; };
+layout(std430, binding = 2) readonly buffer Anchor { RAW anchor[]; };
+#if TRAMPLE
+layout(std430, binding = 3) buffer Trample { RAW trampleLevel[]; };
+#endif
+layout(std430, binding = 4) buffer Fault { uint faultKey; };
+layout(std430, binding = 5) readonly buffer Candidates { uint candidate[]; };  // particle indices
+layout(std430, binding = 6) buffer Backup { RAW backup[]; };  // 7 per candidate: position, velocity, trample
+
+uniform uint countX;
+uniform uint count;       // particles
+uniform uint candidates;  // entries of `candidate`
+uniform uint restore;     // 1: write the backup back (a faulted tick), nothing else
+// The particle under way: position, velocity, anchor, trample level.
+RAW px, py, pz, pu, pv, pw, pax, pay, paz, ptrample;
+
 // [0]: pushAllowance, [1]: rod length (held tips); then per part 17 values: centre (3), rotation
 // row by row (9), half extents (3; a sphere's radius first), share, candidate reach.
-layout(std430, binding = 11) readonly buffer PushValues { RAW pushValue[]; };
+layout(std430, binding = 7) readonly buffer PushValues { RAW pushValue[]; };
 // Per part 4 values: shape (0 sphere, 1 box), body, storage column of its range's first column,
 // columns in the range; then per storage row r, [4 parts + r] and [4 parts + r + 1] bound that
 // row's part list in this array.
-layout(std430, binding = 12) readonly buffer PushInts { int pushInt[]; };
-layout(std430, binding = 13) buffer PushCounts { uint pushCount[]; };  // per body (grass drag)
-uniform uint pushParts;  // parts pushing this tick; 0: no push
+layout(std430, binding = 8) readonly buffer PushInts { int pushInt[]; };
+layout(std430, binding = 9) buffer PushCounts { uint pushCount[]; };  // per body (grass drag)
+uniform uint pushParts;  // parts pushing this tick (> 0)
 uniform uint pushFlags;  // 1 nearest-face box normal (else up), 2 held tips, 4 grid ranges, 8 count pushes
 
-// The particle under way: position, velocity, anchor, trample level.
-RAW px, py, pz, pu, pv, pw, pax, pay, paz, ptrample;
 
 RAW partValue(int part, int k) { return pushValue[2 + 17 * part + k]; }
 
@@ -501,135 +637,40 @@ void pushParticle(uint row, uint column) {
   }
 }
 
+
+
 void main() {
-  uint i = gl_GlobalInvocationID.x;
-  if (i >= count) return;
-  uint row = i / countX, column = i - row * countX;
-  RAW dt = tickData[0], rod = tickData[2], invDt = tickData[3];
-  // The run of this row whose columns hold this particle: the CPU advances a row run by run, in
-  // column order, so its fault order is (row, run, stage, column). The key below orders the same
-  // way: run k of the row covers keys [2 begin_k, 2 end_k) after the row's base.
-  // (Each run's end is stored beside its begin. Read instead as `k + 1 < endRun ? <the next run's
-  // begin> : countX`, it came out 0 for a row's first run on llvmpipe (Mesa 22.3.6), though the
-  // loop above had just read the same element as non-zero; tests/gpu_physics_test.cpp's
-  // properties found it.)
-  uint endRun = runs[row + 1u], k = runs[row];
-  while (k + 1u < endRun && runs[countZ + 1u + 2u * (k + 1u)] <= column) ++k;
-  uint pieceBegin = runs[countZ + 1u + 2u * k];
-  uint pieceEnd = runs[countZ + 2u + 2u * k];
-  uint integrationKey = row * 2u * countX + 2u * pieceBegin + (column - pieceBegin);
-  uint projectionKey = integrationKey + (pieceEnd - pieceBegin);
-  RAW dvx = tickData[8u + 3u * k], dvy = tickData[9u + 3u * k], dvz = tickData[10u + 3u * k];
-  uint j = i + count, l = j + count;  // y and z of particle i
-  px = positionIn[i];
-  py = positionIn[j];
-  pz = positionIn[l];
-  pu = velocityIn[i];
-  pv = velocityIn[j];
-  pw = velocityIn[l];
-  pax = anchor[i];
-  pay = anchor[j];
-  paz = anchor[l];
+  uint k = gl_GlobalInvocationID.x;
+  if (k >= candidates) return;
+  uint i = candidate[k], j = i + count, l = j + count;
+  uint b = 7u * k;
+  if (restore != 0u) {
+    position[i] = backup[b]; position[j] = backup[b + 1u]; position[l] = backup[b + 2u];
+    velocity[i] = backup[b + 3u]; velocity[j] = backup[b + 4u]; velocity[l] = backup[b + 5u];
 #if TRAMPLE
-  ptrample = trampleIn[i];
+    trampleLevel[i] = backup[b + 6u];
 #endif
-  overflowed = false;
-  if (pushParts != 0u) {
-    pushParticle(row, column);
-    if (overflowed) noteFault(0u);
-    overflowed = false;
+    return;
   }
-  RAW x = px, y = py, z = pz;
-  RAW u = pu, v = pv, w = pw;
-  RAW ax = pax, ay = pay, az = paz;
-  RAW nx, ny, nz;
-#if MODEL == 2
-  // blade.h: one loop, every fault the integration's.
-  RAW stiffness = tickData[4], damping = tickData[5], decay = tickData[6], invRod = tickData[7];
+  px = position[i]; py = position[j]; pz = position[l];
+  pu = velocity[i]; pv = velocity[j]; pw = velocity[l];
+  pax = anchor[i]; pay = anchor[j]; paz = anchor[l];
+  ptrample = RAW(0);
 #if TRAMPLE
-  RAW trample = ptrample;
-  stiffness = mulChecked(stiffness, subChecked(RAW(ONE), trample));
-  trampleOut[i] = trample > decay ? subChecked(trample, decay) : RAW(0);
+  ptrample = trampleLevel[i];
 #endif
-  RAW rx = subChecked(x, ax), ry = subChecked(y, ay), rz = subChecked(z, az);
-  RAW gx = subChecked(dvx, mulChecked(stiffness, rx));
-  RAW gy = subChecked(dvy, mulChecked(stiffness, subChecked(ry, rod)));
-  RAW gz = subChecked(dvz, mulChecked(stiffness, rz));
-  RAW along = mulChecked(
-      mulChecked(addChecked(addChecked(mulChecked(gx, rx), mulChecked(gy, ry)), mulChecked(gz, rz)), invRod), invRod);
-  gx = subChecked(gx, mulChecked(rx, along));
-  gy = subChecked(gy, mulChecked(ry, along));
-  gz = subChecked(gz, mulChecked(rz, along));
-  u = mulChecked(addChecked(u, gx), damping);
-  v = mulChecked(addChecked(v, gy), damping);
-  w = mulChecked(addChecked(w, gz), damping);
-  RAW predictedX = addChecked(x, mulChecked(u, dt)), predictedY = addChecked(y, mulChecked(v, dt)),
-      predictedZ = addChecked(z, mulChecked(w, dt));
-  RAW ex = subChecked(predictedX, ax), ey = predictedY > ay ? subChecked(predictedY, ay) : RAW(0),
-      ez = subChecked(predictedZ, az);
-  RAW len = length3(ex, ey, ez);
-  nx = ax;
-  ny = addChecked(ay, rod);  // computed whether or not it is used, as the reference does
-  nz = az;
-  if (len != RAW(0)) {
-    RAW scale = divChecked(rod, len);
-    nx = addChecked(ax, mulChecked(ex, scale));
-    ny = addChecked(ay, mulChecked(ey, scale));
-    nz = addChecked(az, mulChecked(ez, scale));
-  }
-  u = addChecked(u, mulChecked(subChecked(nx, predictedX), invDt));
-  v = addChecked(v, mulChecked(subChecked(ny, predictedY), invDt));
-  w = addChecked(w, mulChecked(subChecked(nz, predictedZ), invDt));
-  checkFinite(nx, ny, nz, u, v, w);
-  if (overflowed) noteFault(integrationKey);
-#else
-  RAW damping = tickData[1];
-  // Stage 3, integrate.h: explicit order for "thesis", symplectic for "pbd".
-#if MODEL == 0
-  x = addChecked(x, mulChecked(u, dt));
-  y = addChecked(y, mulChecked(v, dt));
-  z = addChecked(z, mulChecked(w, dt));
-#endif
-  u = mulChecked(addChecked(u, dvx), damping);
-  v = mulChecked(addChecked(v, dvy), damping);
-  w = mulChecked(addChecked(w, dvz), damping);
-#if MODEL == 1
-  x = addChecked(x, mulChecked(u, dt));
-  y = addChecked(y, mulChecked(v, dt));
-  z = addChecked(z, mulChecked(w, dt));
-#endif
-  checkFinite(x, y, z, u, v, w);
-  if (overflowed) noteFault(integrationKey);
-
-  // Stage 4, rod_constraint.h.
+  backup[b] = px; backup[b + 1u] = py; backup[b + 2u] = pz;
+  backup[b + 3u] = pu; backup[b + 4u] = pv; backup[b + 5u] = pw;
+  backup[b + 6u] = ptrample;
   overflowed = false;
-  RAW dx = subChecked(x, ax), dy = subChecked(y, ay), dz = subChecked(z, az);
-  RAW len = length3(dx, dy, dz);
-  if (len == RAW(0)) {
-    nx = ax;
-    ny = addChecked(ay, rod);
-    nz = az;
-  } else {
-    RAW scale = divChecked(rod, len);
-    nx = addChecked(ax, mulChecked(dx, scale));
-    ny = addChecked(ay, mulChecked(dy, scale));
-    nz = addChecked(az, mulChecked(dz, scale));
-  }
-#if MODEL == 1
-  u = addChecked(u, mulChecked(subChecked(nx, x), invDt));
-  v = addChecked(v, mulChecked(subChecked(ny, y), invDt));
-  w = addChecked(w, mulChecked(subChecked(nz, z), invDt));
+  uint row = i / countX;
+  pushParticle(row, i - row * countX);
+  if (overflowed) atomicMin(faultKey, 0u);
+  position[i] = px; position[j] = py; position[l] = pz;
+  velocity[i] = pu; velocity[j] = pv; velocity[l] = pw;
+#if TRAMPLE
+  trampleLevel[i] = ptrample;
 #endif
-  checkFinite(nx, ny, nz, u, v, w);
-  if (overflowed) noteFault(projectionKey);
-#endif
-
-  positionOut[i] = nx; positionOut[j] = ny; positionOut[l] = nz;
-  velocityOut[i] = u; velocityOut[j] = v; velocityOut[l] = w;
-  // The tip displacement the patch stage reads (patch_state.h): unchecked, wrapping.
-  displacement[i] = nx - ax;
-  displacement[j] = ny - ay - rod;
-  displacement[l] = nz - az;
 }
 )GLSL";
 

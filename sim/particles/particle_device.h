@@ -31,9 +31,9 @@ struct DeviceWind {
   std::vector<S> dvx, dvy, dvz;      ///< per run (m/s)
 };
 
-/// This tick's body pushes as a device applies them: fused into the particle pass, before the
-/// integration (sim/collision/body_particles.h: per particle the same parts in the same order,
-/// the same escape chain, the same bits). The device reads the pushers' poses, shapes, shares,
+/// This tick's body pushes as a device applies them, just before its particle pass
+/// (sim/collision/body_particles.h: per particle the same parts in the same order, the same
+/// escape chain, the same bits). The device reads the pushers' poses, shapes, shares,
 /// column ranges and row buckets, all computed on the host (prepareGrassPushers).
 template <class S>
 struct DevicePush {
@@ -67,7 +67,7 @@ class ParticleDevice {
   /// Copies the host's particle state (trample levels included) and anchors to the device (the
   /// host is the truth).
   virtual void upload(const ParticleArrays<S>& p) = 0;
-  /// One fused pass over every particle under `wind`, after `push` (null: no body pushes).
+  /// The bodies' `push` (null: none), then one fused pass over every particle under `wind`.
   /// Returns a fault (particle >= 0) when the pass faulted anywhere: where the fault is the
   /// integration's or the projection's and no push faulted, the one the CPU reference reports
   /// (the first faulting row's; within a row, run by run in column order, a run's first

@@ -222,9 +222,9 @@ class World final : public SimWorld {
   PhysicsPath physicsPath_ = PhysicsPath::Cpu;
   std::unique_ptr<ParticleDevice<S>> device_;
   DeviceWind<S> deviceWind_;  ///< the tick's wind as the device reads it (scratch, not state)
-  /// The grass push of the response stage, left to the device's particle pass (which applies it
-  /// before the integration, in the same order, with the same bits; the host redoes both where
-  /// the pass faults). Scratch of one tick, not state.
+  /// The grass push of the response stage, left to the device (its push pass runs just before its
+  /// particle pass, in the same order, with the same bits; the host redoes both where either
+  /// faults). Scratch of one tick, not state.
   GrassPushers<S> devicePushers_;
   bool devicePushPending_ = false;
   std::vector<int64_t> devicePushedPerBody_;
