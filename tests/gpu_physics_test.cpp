@@ -21,6 +21,8 @@
 #include "sim/particles/particle_row.h"
 #include "tests/cli_support.h"
 #include "tests/test_support.h"
+#include "viewer/offscreen/osmesa_context.h"
+#include "viewer/render/scene.h"
 
 namespace sg {
 namespace viewer_test {
@@ -239,22 +241,75 @@ TEST(GpuPhysics, TheResidentPathCopiesBackOnlyTheFaultWord) {
 /// 240 bytes: one fault word a tick.
 TEST(GpuPhysics, RenderDrawsTheDevicesTopsWithoutCopyingThemBack) {
   TempDir dir;
+  // The meadow; and blade-bodies, whose bodies push the grass on the device and leave trampled
+  // blades there, drawn darker and flatter from the device's trample levels.
+  struct Case {
+    const char* scenario;
+    const char* ticks;
+    int64_t lastTick;
+    std::vector<const char*> frames;
+  };
+  for (const Case& c :
+       {Case{"thesis-meadow", "0:60:30", 60, {"frame-000000.png", "frame-000030.png", "frame-000060.png"}},
+        Case{"blade-bodies", "90:180:90", 180, {"frame-000090.png", "frame-000180.png"}}}) {
+    const std::string scenario = quote(test::sourcePath(std::string("scenarios/") + c.scenario + ".json"));
+    for (const char* path : {"cpu", "gpu"}) {
+      const CliResult r = runCli("render " + scenario + " -o " + quote(dir.file(std::string(c.scenario) + path)) +
+                                 " --ticks " + c.ticks + " --size 200x120 --json --physics " + path);
+      ASSERT_EQ(r.exitCode, 0) << r.describe();
+      const json j = parseJson(r);
+      EXPECT_EQ(j.at("deviceBytesToHost").get<int64_t>(), std::string(path) == "gpu" ? c.lastTick * 4 : 0) << r.out;
+    }
+    for (const char* frame : c.frames) {
+      const std::vector<uint8_t> cpu = readBytes(dir.file(std::string(c.scenario) + "cpu/" + frame));
+      ASSERT_FALSE(cpu.empty()) << frame;
+      EXPECT_TRUE(cpu == readBytes(dir.file(std::string(c.scenario) + "gpu/" + frame)))
+          << c.scenario << " " << frame << " differs";
+    }
+  }
   const std::string scenario = quote(test::sourcePath("scenarios/thesis-meadow.json"));
-  for (const char* path : {"cpu", "gpu"}) {
-    const CliResult r = runCli("render " + scenario + " -o " + quote(dir.file(path)) +
-                               " --ticks 0:60:30 --size 200x120 --json --physics " + path);
-    ASSERT_EQ(r.exitCode, 0) << r.describe();
-    const json j = parseJson(r);
-    EXPECT_EQ(j.at("deviceBytesToHost").get<int64_t>(), std::string(path) == "gpu" ? 60 * 4 : 0) << r.out;
-  }
-  for (const char* frame : {"frame-000000.png", "frame-000030.png", "frame-000060.png"}) {
-    const std::vector<uint8_t> cpu = readBytes(dir.file(std::string("cpu/") + frame));
-    ASSERT_FALSE(cpu.empty()) << frame;
-    EXPECT_TRUE(cpu == readBytes(dir.file(std::string("gpu/") + frame))) << frame << " differs";
-  }
   const CliResult bad = runCli("render " + scenario + " -o " + quote(dir.file("bad")) + " --physics cuda");
   EXPECT_EQ(bad.exitCode, 2);
   EXPECT_TRUE(isOneLine(bad.err));
+}
+
+/// The viewer's display interpolation between ticks (interpolateScene) on the device path: the
+/// renderer blends the tops from the device's two draw buffers, the tick before and this one, as
+/// the host blends its own: the CPU path's interpolated frame, which is neither tick's (the
+/// meadow's tips move up to 1.7 mm a tick at tick 40).
+TEST(GpuPhysics, DisplayInterpolationBlendsTheDevicesTwoTicks) {
+  std::string error;
+  auto offscreen = viewer::OffscreenRenderer::create(240, 160, 0, &error);
+  ASSERT_TRUE(offscreen) << error;
+  auto inContext = gpu::makeCurrentContextPhysicsProvider(&error);
+  ASSERT_TRUE(inContext) << error;
+  const Scenario s = scenarioNamed("thesis-meadow", "fx32");
+  auto cpu = makeWorld(s, 1);
+  auto gpu = makeWorld(s, 1);
+  ASSERT_EQ(gpu->setPhysicsPath(PhysicsPath::Gpu, inContext.get()), "");
+  for (int64_t t = 0; t < 40; ++t) {
+    ASSERT_TRUE(cpu->step(TickInput{}).ok);
+    ASSERT_TRUE(gpu->step(TickInput{}).ok);
+  }
+  viewer::Scene beforeCpu, beforeGpu, nowCpu, nowGpu, shownCpu, shownGpu;
+  viewer::extractScene(*cpu, s, &beforeCpu);
+  viewer::extractScene(*gpu, s, &beforeGpu);
+  ASSERT_TRUE(cpu->step(TickInput{}).ok);
+  ASSERT_TRUE(gpu->step(TickInput{}).ok);
+  viewer::extractScene(*cpu, s, &nowCpu);
+  viewer::extractScene(*gpu, s, &nowGpu);
+  ASSERT_NE(beforeGpu.deviceTops, 0u);
+  ASSERT_NE(nowGpu.deviceTops, beforeGpu.deviceTops) << "the device alternates its draw buffers";
+  viewer::interpolateScene(beforeCpu, nowCpu, 0.5f, &shownCpu);
+  viewer::interpolateScene(beforeGpu, nowGpu, 0.5f, &shownGpu);
+  ASSERT_EQ(shownGpu.deviceTopsPrevious, beforeGpu.deviceTops);
+  const viewer::Camera camera = viewer::Camera::lookingAt(-1.5f, 0.9f, -1.5f, 0, 0.4f, 0);
+  const viewer::Image cpuHalf = offscreen->render(shownCpu, camera), gpuHalf = offscreen->render(shownGpu, camera);
+  const viewer::Image gpuNow = offscreen->render(nowGpu, camera), gpuBefore = offscreen->render(beforeGpu, camera);
+  EXPECT_TRUE(gpuHalf.rgba == cpuHalf.rgba) << "half way between two ticks: the CPU path's frame";
+  EXPECT_FALSE(gpuHalf.rgba == gpuNow.rgba);
+  EXPECT_FALSE(gpuHalf.rgba == gpuBefore.rgba) << "the tick before's buffer still holds its own state";
+  gpu.reset();  // its device, while the provider's context is current
 }
 
 /// The viewer runs the device in its window's GLX context (`--physics gpu`, the script's and the

@@ -90,7 +90,15 @@ enum PushBinding : GLuint {
   kPushCounts
 };
 // The patch pass's bindings (kPatchPassGlsl).
-enum PatchBinding : GLuint { kPatchDisplacement, kPatchConstants, kPatchRootY, kPatchCut, kPatchOut, kPatchDraw };
+enum PatchBinding : GLuint {
+  kPatchDisplacement,
+  kPatchConstants,
+  kPatchRootY,
+  kPatchCut,
+  kPatchOut,
+  kPatchDraw,
+  kPatchTrample
+};
 
 /// What a value of S is stored as in the buffers: a fixed-point value is its raw integer, a float
 /// itself.
@@ -264,7 +272,8 @@ class GlParticleDevice final : public ParticleDevice<S> {
       glNamedBufferData(rootY_, patchCount * GLsizeiptr(sizeof(Raw)), nullptr, GL_DYNAMIC_DRAW);
       glNamedBufferData(cut_, patchCount * GLsizeiptr(sizeof(GLuint)), nullptr, GL_DYNAMIC_DRAW);
       glNamedBufferData(patchOut_, 4 * patchCount * GLsizeiptr(sizeof(Raw)), nullptr, GL_DYNAMIC_COPY);
-      glNamedBufferData(patchDraw_, patchCount * GLsizeiptr(4 * sizeof(float)), nullptr, GL_DYNAMIC_COPY);
+      for (GLuint b : patchDraw_)
+        glNamedBufferData(b, patchCount * GLsizeiptr(4 * sizeof(float)), nullptr, GL_DYNAMIC_COPY);
       patchRevision_ = 0;
     }
     const PatchStateConstants<S>& c = *in.constants;
@@ -283,12 +292,14 @@ class GlParticleDevice final : public ParticleDevice<S> {
       traffic_.toDevice += patchCount * GLsizeiptr(sizeof(Raw) + sizeof(GLuint));
     }
     glUseProgram(patchProgram_);
+    drawCurrent_ ^= 1u;  // the other draw buffer: the last one keeps the state it was derived from
     const std::pair<PatchBinding, GLuint> bindings[] = {{kPatchDisplacement, displacement_},
                                                         {kPatchConstants, patchConstantBuffer_},
                                                         {kPatchRootY, rootY_},
                                                         {kPatchCut, cut_},
                                                         {kPatchOut, patchOut_},
-                                                        {kPatchDraw, patchDraw_}};
+                                                        {kPatchDraw, patchDraw_[drawCurrent_]},
+                                                        {kPatchTrample, trample_[current_]}};
     for (const auto& [binding, buffer] : bindings) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer);
     const auto window = [](const LatticeWindow& w) {
       return std::array<GLint, 4>{GLint(w.originI), GLint(w.originJ), GLint(w.sizeI), GLint(w.sizeJ)};
@@ -301,6 +312,7 @@ class GlParticleDevice final : public ParticleDevice<S> {
                 GLint(in.patches.storageRow(in.patches.originJ)));
     glUniform1ui(glGetUniformLocation(p, "patchCount"), GLuint(patchCount));
     glUniform1ui(glGetUniformLocation(p, "particleCount"), GLuint(countX_ * countZ_));
+    glUniform1i(glGetUniformLocation(p, "tramples"), tramples_ ? 1 : 0);
     glDispatchCompute(GLuint((patchCount + 255) / 256), 1, 1);
     // A renderer reads the draw copy as a vertex attribute or a buffer texture.
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT |
@@ -322,7 +334,7 @@ class GlParticleDevice final : public ParticleDevice<S> {
     }
   }
 
-  uint32_t patchDrawBuffer() const override { return patchCount_ > 0 && patchesFit_ ? patchDraw_ : 0; }
+  uint32_t patchDrawBuffer() const override { return patchCount_ > 0 && patchesFit_ ? patchDraw_[drawCurrent_] : 0; }
   DeviceTraffic traffic() const override { return traffic_; }
 
  private:
@@ -481,10 +493,11 @@ class GlParticleDevice final : public ParticleDevice<S> {
     return {row * countX_, Stage::Integrate};  // unreachable: the runs cover the row
   }
 
-  std::array<GLuint*, 21> buffers() {
-    return {&position_[0],  &position_[1], &velocity_[0], &velocity_[1], &trample_[0],          &trample_[1], &anchor_,
-            &displacement_, &tickBuffer_,  &runBuffer_,   &fault_,       &patchConstantBuffer_, &rootY_,      &cut_,
-            &patchOut_,     &patchDraw_,   &pushValues_,  &pushInts_,    &pushCounts_,          &candidates_, &backup_};
+  std::array<GLuint*, 22> buffers() {
+    return {&position_[0], &position_[1],  &velocity_[0], &velocity_[1],  &trample_[0],   &trample_[1],
+            &anchor_,      &displacement_, &tickBuffer_,  &runBuffer_,    &fault_,        &patchConstantBuffer_,
+            &rootY_,       &cut_,          &patchOut_,    &patchDraw_[0], &patchDraw_[1], &pushValues_,
+            &pushInts_,    &pushCounts_,   &candidates_,  &backup_};
   }
 
   std::shared_ptr<ComputeContext> context_;
@@ -514,7 +527,11 @@ class GlParticleDevice final : public ParticleDevice<S> {
   std::vector<GLuint> pushCountWords_;
   // The patch stage (derivePatches): per patch slot, the inputs (root height, cut flag as a
   // 32-bit word) copied when their revision changes, and the outputs.
-  GLuint patchConstantBuffer_ = 0, rootY_ = 0, cut_ = 0, patchOut_ = 0, patchDraw_ = 0;
+  GLuint patchConstantBuffer_ = 0, rootY_ = 0, cut_ = 0, patchOut_ = 0;
+  /// The draw copy, alternating between two buffers derive by derive: the last one's buffer keeps
+  /// the state before it (a renderer interpolating between two ticks reads both).
+  GLuint patchDraw_[2] = {};
+  GLuint drawCurrent_ = 0;
   GLsizeiptr patchConstantCapacity_ = 0;
   int64_t patchCount_ = 0;
   bool patchesFit_ = true;      ///< the window's patches fit the device's storage blocks

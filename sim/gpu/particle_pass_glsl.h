@@ -693,6 +693,8 @@ layout(std430, binding = 3) readonly buffer Cut { uint cutFlags[]; };   // per p
 // Tip offset x, tip offset z, top y, tilt level: four arrays of patchCount values.
 layout(std430, binding = 4) writeonly buffer PatchOut { RAW patchOut[]; };
 layout(std430, binding = 5) writeonly buffer PatchDraw { vec4 patchDraw[]; };
+// The particles' trample levels (model blade with trampling; read only where `tramples`).
+layout(std430, binding = 6) readonly buffer Trample { RAW trampleLevel[]; };
 
 uniform int k;
 uniform ivec4 particleWindow;        // originI, originJ, sizeI, sizeJ (lattice_window.h)
@@ -700,6 +702,7 @@ uniform ivec4 patchWindow;
 uniform ivec2 patchStorageOrigin;    // storage column of patchWindow's originI, storage row of originJ
 uniform uint patchCount;
 uniform uint particleCount;
+uniform bool tramples;
 
 #if FLOAT
 RAW blend(RAW a, RAW b, RAW w) { precise RAW d = b - a; precise RAW p = d * w; precise RAW r = a + p; return r; }
@@ -760,7 +763,16 @@ void main() {
   patchOut[patchCount + p] = d[2];
   patchOut[2u * patchCount + p] = topY;
   patchOut[3u * patchCount + p] = RAW(tilt);
-  patchDraw[p] = vec4(toMetres(topY), toMetres(d[0]), toMetres(d[2]), float(cut ? 3u : tilt));
+  // The trample level of the particle the patch takes its motion from (its lower-left one), as
+  // the scene extraction shows it: lround(255 clamp(level, 0, 1)), added as 4 x that to the
+  // brightness level (both exact in a float).
+  uint trampled = 0u;
+  if (tramples) {
+    double level = clamp(double(trampleLevel[r0 + sa]) / double(ONE), 0.0lf, 1.0lf) * 255.0lf;
+    double whole = floor(level);
+    trampled = uint(whole) + (level - whole >= 0.5lf ? 1u : 0u);
+  }
+  patchDraw[p] = vec4(toMetres(topY), toMetres(d[0]), toMetres(d[2]), float((cut ? 3u : tilt) + 4u * trampled));
 }
 )GLSL";
 

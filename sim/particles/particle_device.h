@@ -96,7 +96,11 @@ class ParticleDevice {
   /// A renderer sharing the device's context draws from this buffer (an OpenGL buffer name; 0
   /// when the device has none): per patch slot four floats, top y, tip offset x, tip offset z (m,
   /// each the double of its exact value rounded to float, as the host's scene extraction does)
-  /// and the brightness level (the tilt level, 3 where mown).
+  /// and the brightness level (the tilt level, 3 where mown) plus 4 x the trample level of the
+  /// patch's lower-left particle as the scene shows it (0..255, lround(255 level); 0 without
+  /// trampling).
+  /// Each derivePatches writes the other of two buffers, so the buffer the one before returned
+  /// still holds its state (a renderer interpolating between two ticks reads both).
   virtual uint32_t patchDrawBuffer() const = 0;
   /// Host <-> device copies so far.
   virtual DeviceTraffic traffic() const = 0;

@@ -378,7 +378,7 @@ struct Renderer::Impl {
   size_t tuftCapacity = 0;
   // The GPU physics path: per drawn tuft its slot in the device's patch buffer (attribute 3),
   // and that buffer seen as a buffer texture (Scene::deviceTops).
-  GLuint slotBuffer = 0, deviceTopTexture = 0;
+  GLuint slotBuffer = 0, deviceTopTexture = 0, previousTopTexture = 0;
   std::vector<GLint> slots;
 
   /// Binds the device's tops (or none) for the tuft programs' next draws of instances whose
@@ -395,13 +395,21 @@ struct Renderer::Impl {
     glActiveTexture(GL_TEXTURE0 + kDeviceTopsUnit);
     glBindTexture(GL_TEXTURE_BUFFER, deviceTopTexture);
     glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, scene.deviceTops);
+    if (scene.deviceTopsPrevious != 0) {  // display interpolation: the tick before, too
+      glActiveTexture(GL_TEXTURE0 + kPreviousTopsUnit);
+      glBindTexture(GL_TEXTURE_BUFFER, previousTopTexture);
+      glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, scene.deviceTopsPrevious);
+    }
     glActiveTexture(GL_TEXTURE0);
   }
   void deviceTopUniforms(GLuint p, const Scene& scene) const {
     glUniform1i(loc(p, "uDeviceTops"), scene.deviceTops != 0 ? 1 : 0);
     glUniform1i(loc(p, "uTops"), kDeviceTopsUnit);
+    glUniform1i(loc(p, "uTopsLerp"), scene.deviceTops != 0 && scene.deviceTopsPrevious != 0 ? 1 : 0);
+    glUniform1i(loc(p, "uPreviousTops"), kPreviousTopsUnit);
+    glUniform1f(loc(p, "uTopsAlpha"), scene.deviceTopsAlpha);
   }
-  static constexpr GLint kDeviceTopsUnit = 5;
+  static constexpr GLint kDeviceTopsUnit = 5, kPreviousTopsUnit = 6;
   Mesh sphere, cube, ground;
   uint64_t groundRevision = 0;
   // The terrain under the tufts: the ground grid's inner heights as a float texture.
@@ -571,6 +579,7 @@ struct Renderer::Impl {
     for (GLuint* b : {&tuftBuffer, &debugBuffer, &slotBuffer})
       if (*b) glDeleteBuffers(1, b);
     if (deviceTopTexture) glDeleteTextures(1, &deviceTopTexture);
+    if (previousTopTexture) glDeleteTextures(1, &previousTopTexture);
     for (GLuint* a : {&tuftVao, &emptyVao, &debugVao})
       if (*a) glDeleteVertexArrays(1, a);
     sphere.release();
@@ -625,6 +634,7 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
   glVertexAttribDivisor(2, 2);
   glGenBuffers(1, &r.slotBuffer);
   glGenTextures(1, &r.deviceTopTexture);
+  glGenTextures(1, &r.previousTopTexture);
   glBindBuffer(GL_ARRAY_BUFFER, r.slotBuffer);
   glVertexAttribIPointer(3, 1, GL_INT, sizeof(GLint), nullptr);
   glVertexAttribDivisor(3, 2);

@@ -503,7 +503,7 @@ void extractTyped(const World<S>& w, const Scenario& scenario, Scene* scene) {
   // Trails: where bodies pressed the grass (render-side memory), and the blade model's trampling.
   updateTrails(w, scenario, scaleY, scene);
   const TrailMemory& mem = scene->trails;
-  // (Trample levels are particle state: on the device they would have to be copied back.)
+  // (On the device the trample levels are the device's patch stage's, in its draw buffer.)
   const ParticleArrays<S>& pa = onDevice ? w.hostParticles() : w.particles();
   const ParticleGrid& grid = w.particleGrid();
   const bool trampling = !onDevice && !pa.trample.empty();
@@ -747,8 +747,10 @@ void interpolateScene(const Scene& previous, const Scene& current, float alpha, 
   if (t <= 0.0f) {        // exactly previous' tufts and poses, current's everything else
     if (previous.tufts.size() == current.tufts.size() && previous.simulatedTufts == current.simulatedTufts &&
         previous.windowOriginI == current.windowOriginI && previous.windowOriginJ == current.windowOriginJ &&
-        previous.windowWidth == current.windowWidth && previous.windowHeight == current.windowHeight)
+        previous.windowWidth == current.windowWidth && previous.windowHeight == current.windowHeight) {
       out->tufts = previous.tufts;
+      if (previous.deviceTops != 0 && current.deviceTops != 0) out->deviceTops = previous.deviceTops;
+    }
     if (previous.bodyParts.size() == current.bodyParts.size()) out->bodyParts = previous.bodyParts;
     if (previous.meshProxies.size() == current.meshProxies.size()) out->meshProxies = previous.meshProxies;
     return;
@@ -766,6 +768,12 @@ void interpolateScene(const Scene& previous, const Scene& current, float alpha, 
       o.tipX = a.tipX + (o.tipX - a.tipX) * t;
       o.tipZ = a.tipZ + (o.tipZ - a.tipZ) * t;
     }
+  // On the device path the tops are in the device's two draw buffers: the renderer blends them
+  // the same way (its tuft vertex shader).
+  if (sameLayout && current.deviceTops != 0 && previous.deviceTops != 0 && previous.deviceTops != current.deviceTops) {
+    out->deviceTopsPrevious = previous.deviceTops;
+    out->deviceTopsAlpha = t;
+  }
   lerpParts(previous.bodyParts, &out->bodyParts, t);
   lerpParts(previous.meshProxies, &out->meshProxies, t);
 }

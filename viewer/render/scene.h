@@ -133,6 +133,11 @@ struct Scene {
   /// back), and its culling allows each tip `deviceTipReach` metres from the root.
   uint32_t deviceTops = 0;
   float deviceTipReach = 0;
+  /// Display interpolation on the device path (interpolateScene): the previous tick's buffer
+  /// (the device alternates two, ParticleDevice::patchDrawBuffer) and how far toward deviceTops
+  /// the tops, tips are drawn (0: the previous tick's, 1: deviceTops'); 0 buffer: none.
+  uint32_t deviceTopsPrevious = 0;
+  float deviceTopsAlpha = 1;
 };
 
 /// Fills `scene` from the world's current state. The ground grid is rebuilt only when `scene`
@@ -151,7 +156,7 @@ struct Scene {
 ///
 /// A world whose device holds the current patch state (SimWorld::devicePatchDrawBuffer) is
 /// extracted without copying anything back: Scene::deviceTops names the device's buffer (the
-/// renderer must share the device's context), and trampled blades show no trample level.
+/// renderer must share the device's context), the trample levels included.
 void extractScene(const SimWorld& world, const Scenario& scenario, Scene* scene);
 
 /// Which debug overlay layers to build / draw.

@@ -85,6 +85,11 @@ layout(location = 2) in vec4 aTile;  // atlas variant, brightness level, diverge
 layout(location = 3) in int aSlot;
 uniform bool uDeviceTops;
 uniform samplerBuffer uTops;
+// Display interpolation between ticks (interpolateScene): the previous tick's buffer, and how
+// far toward uTops' values the top, tip x and z are drawn, as the host blends its own.
+uniform bool uTopsLerp;
+uniform samplerBuffer uPreviousTops;
+uniform float uTopsAlpha;
 uniform mat4 uViewProj;
 uniform vec4 uTiles[68];             // (variants + 1) * levels tile rects: u0, v0 (top), u1, v1
 uniform int uLevels;
@@ -122,8 +127,15 @@ void main() {
   vec4 top4 = aTop, tile4 = aTile;
   if (uDeviceTops && aSlot >= 0) {
     vec4 d = texelFetch(uTops, aSlot);
+    if (uTopsLerp) {  // a + (b - a) t, as interpolateScene
+      vec3 before = texelFetch(uPreviousTops, aSlot).xyz;
+      d.xyz = before + (d.xyz - before) * uTopsAlpha;
+    }
     top4.xyz = d.xyz;
-    tile4.y = d.w;
+    // The brightness level, plus 4 x the trample level (0..255) where the blades are trampled
+    // (ParticleDevice::patchDrawBuffer): the trail shows the larger of it and the host's.
+    tile4.y = mod(d.w, 4.0);
+    tile4.w = max(tile4.w, floor(d.w * 0.25));
   }
   // Two instances per tuft (the attributes advance every second instance): the crossed quads,
   // the second turned 90 degrees and showing the tile mirrored, each uCrossWidth as wide as the
