@@ -140,14 +140,11 @@ bool World<S>::respondToContacts() {
   sweepFastBodiesAgainstTerrain(bodies_, start, terrain_, solver_.linearSlop);
   if (bodiesFaulted(Stage::Response)) return false;
   mowGrass();
-  // Grass: pushed out of every body. On a device the push runs there, just before the particle
-  // pass (world_device.cpp): the particles stay on the device.
-  GrassPushers<S> pushers = prepareGrassPushers(bodies_, grid_, bodyParticle_);
-  if (device_) {
-    devicePushers_ = std::move(pushers);
-    devicePushPending_ = true;
-    return true;
-  }
+  // Grass: pushed out of every body. On a device the push runs there (world_device.cpp): the
+  // particles stay on the device; where it could not push, the host does, from the same state.
+  const GrassPushers<S> pushers = prepareGrassPushers(bodies_, grid_, bodyParticle_);
+  std::vector<int64_t> pushed;
+  if (device_ && devicePush(pushers, &pushed)) return grassDragDt_ > S(0) ? applyGrassDrag(pushed) : true;
   return pushGrassOnHost(pushers);
 }
 

@@ -32,6 +32,13 @@ std::string glString(GLenum name) {
   return s ? s : "?";
 }
 
+/// The most work groups one dispatch may have along x (GL guarantees 65,535).
+int64_t maxWorkGroups() {
+  GLint groups = 0;
+  glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &groups);
+  return groups > 0 ? int64_t(groups) : 65535;
+}
+
 /// Compiles and links one compute program; 0 with *error set (the driver's log) on failure.
 GLuint buildProgram(const std::string& source, std::string* error) {
   const GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
@@ -159,8 +166,34 @@ class GlParticleDevice final : public ParticleDevice<S> {
     if (tramples_) put(trample_[current_], {&p.trample});
   }
 
-  RowFault advance(const DeviceWind<S>& wind, const ParticleConstants<S>& c, const DevicePush<S>* push,
-                   uint32_t* faultBits) override {
+  bool push(const DevicePush<S>& push) override {
+    context_->makeCurrent();
+    const GLuint parts = packPush(push);
+    if (parts == 0) return candidateList_.empty();  // no candidate: nothing to push; else too many here
+    if (!pushProgram_) pushProgram_ = makePushProgram_();
+    if (!pushProgram_) return false;  // it did not compile: the host pushes (GlPhysicsProvider::make)
+    const GLuint none = 0xFFFFFFFFu;
+    glNamedBufferSubData(fault_, 0, sizeof none, &none);
+    traffic_.toDevice += sizeof none;
+    runPushPass(parts, false);
+    // Whether a push faulted: the response stage must report it at this tick, before the drag.
+    GLuint key = none;
+    glGetNamedBufferSubData(fault_, 0, sizeof key, &key);
+    traffic_.toHost += sizeof key;
+    if (key != none) {  // the state as the push found it, for the host to push
+      runPushPass(parts, true);
+      return false;
+    }
+    if (push.pushedPerBody) {  // the grass drag's tuft counts
+      pushCountWords_.resize(push.bodyCount);
+      glGetNamedBufferSubData(pushCounts_, 0, GLsizeiptr(push.bodyCount * sizeof(GLuint)), pushCountWords_.data());
+      traffic_.toHost += GLsizeiptr(push.bodyCount * sizeof(GLuint));
+      push.pushedPerBody->assign(pushCountWords_.begin(), pushCountWords_.end());
+    }
+    return true;
+  }
+
+  RowFault advance(const DeviceWind<S>& wind, const ParticleConstants<S>& c, uint32_t* faultBits) override {
     context_->makeCurrent();
     const size_t runCount = wind.runBegin.size();
     using St = Stored<S>;
@@ -185,14 +218,6 @@ class GlParticleDevice final : public ParticleDevice<S> {
     const GLuint none = 0xFFFFFFFFu;
     glNamedBufferSubData(fault_, 0, sizeof none, &none);
     traffic_.toDevice += GLsizeiptr(tick_.size() * sizeof(Raw) + runs_.size() * sizeof(int32_t) + sizeof none);
-    // The bodies' push first, in place on the current state, over the candidates only.
-    const GLuint pushParts = push ? packPush(*push) : 0;
-    if (pushParts > 0 && !pushProgram_) pushProgram_ = makePushProgram_();
-    if (pushParts > 0 && !pushProgram_) {  // it did not compile: the CPU does the tick (GlPhysicsProvider::make)
-      *faultBits = 0;
-      return {0, Stage::Integrate};
-    }
-    if (pushParts > 0) runPushPass(pushParts, false);
     glUseProgram(program_);
     const GLuint next = 1 - current_;
     const std::pair<Binding, GLuint> bindings[] = {{kPositionIn, position_[current_]},
@@ -218,22 +243,13 @@ class GlParticleDevice final : public ParticleDevice<S> {
     GLuint key = none;
     glGetNamedBufferSubData(fault_, 0, sizeof key, &key);
     traffic_.toHost += sizeof key;
-    if (pushParts > 0 && push->pushedPerBody && key == none) {  // the grass drag's tuft counts
-      pushCountWords_.resize(push->bodyCount);
-      glGetNamedBufferSubData(pushCounts_, 0, GLsizeiptr(push->bodyCount * sizeof(GLuint)), pushCountWords_.data());
-      traffic_.toHost += GLsizeiptr(push->bodyCount * sizeof(GLuint));
-      push->pushedPerBody->assign(pushCountWords_.begin(), pushCountWords_.end());
-    }
     *faultBits = 0;
     if (key == none) {
       current_ = next;
       return {};
     }
-    // The tick's input back where the push changed it, for the CPU reference to redo the tick.
-    if (pushParts > 0) runPushPass(pushParts, true);
     // The only fixed-point fault the pass can raise (no d = 0 division, no negative root); a float
-    // pass faults on a non-finite value, which has no fault bits. A push's (key 0) is reported as
-    // the first particle's: the reference redoes the tick and reports its own.
+    // pass faults on a non-finite value, which has no fault bits.
     *faultBits = std::is_same_v<S, float> ? 0u : uint32_t(kFixedFaultOverflow);
     return decode(key, wind);
   }
@@ -266,7 +282,7 @@ class GlParticleDevice final : public ParticleDevice<S> {
       GLint64 maxBlock = 0;
       glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
       patchesFit_ = 4 * patchCount * int64_t(sizeof(Raw)) <= int64_t(maxBlock) &&
-                    patchCount * int64_t(4 * sizeof(float)) <= int64_t(maxBlock);
+                    patchCount * int64_t(4 * sizeof(float)) <= int64_t(maxBlock) && patchCount <= 256 * maxWorkGroups();
       patchCount_ = patchCount;
       if (!patchesFit_) return false;
       glNamedBufferData(rootY_, patchCount * GLsizeiptr(sizeof(Raw)), nullptr, GL_DYNAMIC_DRAW);
@@ -397,18 +413,20 @@ class GlParticleDevice final : public ParticleDevice<S> {
     glUniform1ui(glGetUniformLocation(p, "restore"), restore ? 1u : 0u);
     glUniform1ui(glGetUniformLocation(p, "pushParts"), pushParts);
     glUniform1ui(glGetUniformLocation(p, "pushFlags"), pushFlags_);
-    glDispatchCompute((count + 63) / 64, 1, 1);
+    glDispatchCompute((count + 255) / 256, 1, 1);  // count <= particles: within make()'s bound
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
   }
 
   /// Packs this tick's pushers for the push pass (kPushPassGlsl) into the push buffers, with the
   /// candidates (each storage row's particles in a column range of a part over it, in row and
   /// column order), clears the per-body counts where they are kept and sets pushFlags_; returns
-  /// the number of parts (0: nothing to push).
+  /// the number of parts, 0 when there is nothing to push (no candidate) or the candidates'
+  /// backup would not fit one storage block (the candidates stay listed: the host pushes).
   GLuint packPush(const DevicePush<S>& push) {
     const GrassPushers<S>& pushers = *push.pushers;
     const BodyParticleSettings<S>& settings = *push.settings;
     const size_t parts = pushers.parts.size();
+    candidateList_.clear();
     if (parts == 0) return 0;
     using St = Stored<S>;
     pushValueData_.assign({St::of(settings.pushAllowance), St::of(settings.rodLength)});
@@ -451,12 +469,21 @@ class GlParticleDevice final : public ParticleDevice<S> {
     }
     pushIntData_[lists + size_t(countZ_)] = int32_t(pushIntData_.size());
     if (candidateList_.empty()) return 0;
-    replaceContents(candidates_, candidateList_, &candidateCapacity_);
+    GLint64 maxBlock = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
     const GLsizeiptr backupBytes = GLsizeiptr(7 * candidateList_.size() * sizeof(Raw));
+    if (backupBytes > maxBlock) return 0;
     if (backupBytes > backupCapacity_) {
-      backupCapacity_ = std::max(backupBytes, 2 * backupCapacity_);
+      backupCapacity_ = std::min<GLsizeiptr>(std::max(backupBytes, 2 * backupCapacity_), GLsizeiptr(maxBlock));
+      while (glGetError() != GL_NO_ERROR) {
+      }
       glNamedBufferData(backup_, backupCapacity_, nullptr, GL_DYNAMIC_COPY);
+      if (glGetError() != GL_NO_ERROR) {  // out of memory: the host pushes
+        backupCapacity_ = 0;
+        return 0;
+      }
     }
+    replaceContents(candidates_, candidateList_, &candidateCapacity_);
     traffic_.toDevice += GLsizeiptr(candidateList_.size() * sizeof(GLuint));
     replaceContents(pushValues_, pushValueData_, &pushValueCapacity_);
     replaceContents(pushInts_, pushIntData_, &pushIntCapacity_);
@@ -581,6 +608,11 @@ class GlPhysicsProvider final : public ParticleDeviceProvider {
     if (n <= 0 || n >= (int64_t(1) << 30) || blockBytes > int64_t(maxBlock)) {
       *error = "GPU physics: " + std::to_string(n) + " particles need " + std::to_string(blockBytes) +
                "-byte storage buffers; this device allows " + std::to_string(int64_t(maxBlock));
+      return nullptr;
+    }
+    if (n > 256 * maxWorkGroups()) {  // one invocation a particle, 256 a work group
+      *error = "GPU physics: " + std::to_string(n) + " particles need more than " + std::to_string(maxWorkGroups()) +
+               " work groups, this device's most in one dispatch";
       return nullptr;
     }
     // One program per format, model and trampling, compiled on first use and kept.

@@ -180,6 +180,7 @@ RAW mulChecked(RAW a, RAW b) {
   return narrow((p + (1l << 15) + (p >> 63)) >> 16);
 }
 RAW divChecked(RAW a, RAW b) {
+  if (b == 0) { overflowed = true; return a < 0 ? RAW(0x80000000u) : RAW(0x7FFFFFFF); }  // Fixed's fault and value
   bool negative = (a < 0) != (b < 0);
   uint64_t un = uint64_t(abs(int64_t(a))) << 16, ud = uint64_t(abs(int64_t(b)));
   uint64_t q = un / ud, r = un - q * ud;
@@ -353,12 +354,12 @@ void main() {
 /// lies in one of their ranges (a list the host builds from the pushers, without positions). Per
 /// particle the parts over its row, in (body, part) order, each where the particle lies in its
 /// range and reach cube, with the same operations and the same escape chain as
-/// pushParticlesOutOfBodies. It runs before the particle pass, in place on the current state, and
-/// keeps each candidate's state as it found it (backup), so a tick that faults, in the push or the
-/// pass, can put the tick's input back (`restore`): the host then redoes the tick. A push that
-/// faults, or may have, offers fault key 0. Put after kScalarGlsl.
+/// pushParticlesOutOfBodies. It runs in the response stage, as the CPU's push, in place on the
+/// current state, and keeps each candidate's state as it found it (backup): a push that faults,
+/// or may have, offers fault key 0, and a second dispatch (`restore`) puts the state back for the
+/// host to push. Put after kScalarGlsl.
 inline constexpr const char* kPushPassGlsl = R"GLSL(
-layout(local_size_x = 64) in;
+layout(local_size_x = 256) in;
 
 layout(std430, binding = 0) buffer Position { RAW position[]; };  // x, y, z arrays of `count`
 layout(std430, binding = 1) buffer Velocity { RAW velocity[]; };
@@ -427,7 +428,8 @@ bool length3AtLeast(RAW x, RAW y, RAW z, RAW r) {
   sumOfSquares(x, y, z, h, l);
   uint64_t radius = uint64_t(r), qh, ql;
   mul64x64(radius, radius, qh, ql);
-  uint64_t d = radius - 1ul;
+  if (radius == 0ul) return h != 0ul || l != 0ul;  // r^2 - r + 1 = 1
+  uint64_t d = radius - 1ul;  // r^2 - (r - 1) >= 1: no borrow out of the high word
   uint64_t th = qh - (ql < d ? 1ul : 0ul), tl = ql - d;
   return lessOrEqual128(th, tl, h, l);
 }

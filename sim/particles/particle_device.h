@@ -31,7 +31,7 @@ struct DeviceWind {
   std::vector<S> dvx, dvy, dvz;      ///< per run (m/s)
 };
 
-/// This tick's body pushes as a device applies them, just before its particle pass
+/// This tick's body pushes as a device applies them in the response stage, as the CPU does
 /// (sim/collision/body_particles.h: per particle the same parts in the same order, the same
 /// escape chain, the same bits). The device reads the pushers' poses, shapes, shares,
 /// column ranges and row buckets, all computed on the host (prepareGrassPushers).
@@ -67,16 +67,18 @@ class ParticleDevice {
   /// Copies the host's particle state (trample levels included) and anchors to the device (the
   /// host is the truth).
   virtual void upload(const ParticleArrays<S>& p) = 0;
-  /// The bodies' `push` (null: none), then one fused pass over every particle under `wind`.
-  /// Returns a fault (particle >= 0) when the pass faulted anywhere: where the fault is the
-  /// integration's or the projection's and no push faulted, the one the CPU reference reports
+  /// The bodies' push on the current state. Returns true when it ran: then the state is pushed,
+  /// and push.pushedPerBody (where given) holds each body's count. False when a push faulted, or
+  /// may have (a false alarm is allowed, never a missed fault), or the device cannot push this
+  /// many particles: then the state is as it was before, and the host pushes (and reports the
+  /// reference's fault).
+  virtual bool push(const DevicePush<S>& push) = 0;
+  /// One fused pass over every particle under `wind`. Returns the fault the CPU reference reports
   /// (the first faulting row's; within a row, run by run in column order, a run's first
   /// integration fault before any projection fault), with the fixed-point fault bits in
-  /// *faultBits; a push that may have faulted reports particle 0. A pass that faults keeps the
-  /// device's state as it was before the pass, pushes included: the world then redoes the tick's
-  /// pushes and pass on the CPU, which stops at the fault and reports its own.
-  virtual RowFault advance(const DeviceWind<S>& wind, const ParticleConstants<S>& c, const DevicePush<S>* push,
-                           uint32_t* faultBits) = 0;
+  /// *faultBits. A pass that faults keeps the device's state as it was before the pass (the world
+  /// then redoes the tick's pass on the CPU, which stops at the fault).
+  virtual RowFault advance(const DeviceWind<S>& wind, const ParticleConstants<S>& c, uint32_t* faultBits) = 0;
   /// Particles [first, first + count) of each span in storage order, everything of them (state,
   /// anchors, trample levels), host to device: the cells a level-of-detail window move wrote.
   struct Span {

@@ -116,10 +116,16 @@ class World final : public SimWorld {
   bool collisionStage();
   bool integrateStage();
   bool patchStage();
-  /// The integrate stage's particle pass on the device (physics path Gpu or GpuReadback), with the
-  /// response stage's grass push where it left one (devicePushPending_); false when it faulted,
-  /// with the tick's input (before the push) back on the host for the CPU reference to redo.
+  /// The integrate stage's particle pass on the device (physics path Gpu or GpuReadback); false
+  /// when it faulted, with the tick's input back on the host for the CPU reference to redo.
   bool deviceParticlePass();
+  /// The response stage's grass push on the device; false when it did not run there (a push
+  /// faulted, or may have), with the state before it back on the host for the CPU to push.
+  /// *pushedPerBody: each body's pushed tufts, where the grass drags the bodies.
+  bool devicePush(const GrassPushers<S>& pushers, std::vector<int64_t>* pushedPerBody);
+  /// After a pass or push that faulted on the device: the device's state (the input it kept) to
+  /// the host, which is the truth again until the next upload. Always false.
+  bool handDeviceTickBack();
   /// Why this world's grass stages cannot run on a device ("" when they can).
   std::string deviceLimitation() const;
   /// Copies the device's particles back when they are newer than the host's, and derives the
@@ -222,12 +228,6 @@ class World final : public SimWorld {
   PhysicsPath physicsPath_ = PhysicsPath::Cpu;
   std::unique_ptr<ParticleDevice<S>> device_;
   DeviceWind<S> deviceWind_;  ///< the tick's wind as the device reads it (scratch, not state)
-  /// The grass push of the response stage, left to the device (its push pass runs just before its
-  /// particle pass, in the same order, with the same bits; the host redoes both where either
-  /// faults). Scratch of one tick, not state.
-  GrassPushers<S> devicePushers_;
-  bool devicePushPending_ = false;
-  std::vector<int64_t> devicePushedPerBody_;
   bool deviceAhead_ = false;
   bool hostAhead_ = false;
   /// The device's tip displacements are the current state's (a pass on the `gpu` path since the

@@ -92,31 +92,10 @@ bool World<S>::deviceParticlePass() {
   // from it, so a failed world holds the CPU's state too (the CPU stops the faulting row where it
   // faulted) and its fault report is the reference's own. The host is the truth until the next
   // upload.
-  const auto handBack = [&] {
-    takeFixedFaults();
-    device_->download(particles_, nullptr, nullptr, nullptr);
-    deviceAhead_ = false;
-    hostAhead_ = true;
-    deviceDisplacementCurrent_ = false;
-    return false;
-  };
-  if (pendingFixedFaults() != 0) return handBack();
-  // The response stage's grass push (respondToContacts), applied by the pass before it
-  // integrates; each body's pushed tufts come back only where the grass drags the bodies.
-  DevicePush<S> push;
-  if (devicePushPending_) {
-    push.pushers = &devicePushers_;
-    push.settings = &bodyParticle_;
-    push.window = &grid_.window;
-    push.bodyCount = bodies_.size();
-    if (grassDragDt_ > S(0)) {
-      devicePushedPerBody_.assign(bodies_.size(), 0);
-      push.pushedPerBody = &devicePushedPerBody_;
-    }
-  }
+  if (pendingFixedFaults() != 0) return handDeviceTickBack();
   uint32_t faultBits = 0;
-  const RowFault fault = device_->advance(wind, particleConsts_, devicePushPending_ ? &push : nullptr, &faultBits);
-  if (fault.particle >= 0) return handBack();
+  const RowFault fault = device_->advance(wind, particleConsts_, &faultBits);
+  if (fault.particle >= 0) return handDeviceTickBack();
   deviceAhead_ = true;
   deviceDisplacementCurrent_ = physicsPath_ == PhysicsPath::Gpu;
   devicePatchesCurrent_ = false;
@@ -125,6 +104,41 @@ bool World<S>::deviceParticlePass() {
     device_->download(particles_, &dispX_, &dispY_, &dispZ_);
     deviceAhead_ = false;
   }
+  return true;
+}
+
+template <class S>
+bool World<S>::handDeviceTickBack() {
+  takeFixedFaults();
+  device_->download(particles_, nullptr, nullptr, nullptr);
+  deviceAhead_ = false;
+  hostAhead_ = true;
+  deviceDisplacementCurrent_ = false;
+  return false;
+}
+
+template <class S>
+bool World<S>::devicePush(const GrassPushers<S>& pushers, std::vector<int64_t>* pushedPerBody) {
+  if (hostAhead_) {
+    device_->upload(particles_);
+    hostAhead_ = false;
+  }
+  // Faults already raised this tick (mowing, the pushers' ranges) are the CPU reference's to
+  // report or discard, as its rows meet them: the host pushes.
+  if (pendingFixedFaults() != 0) return handDeviceTickBack();
+  DevicePush<S> push;
+  push.pushers = &pushers;
+  push.settings = &bodyParticle_;
+  push.window = &grid_.window;
+  push.bodyCount = bodies_.size();
+  if (grassDragDt_ > S(0)) {  // each body's pushed tufts come back only where they drag it
+    pushedPerBody->assign(bodies_.size(), 0);
+    push.pushedPerBody = pushedPerBody;
+  }
+  if (!device_->push(push)) return handDeviceTickBack();
+  // The pushed state is the device's; its tip displacement is still the last pass's, as the
+  // host's is until its pass (a tick that stops here, at the grass drag, keeps both).
+  deviceAhead_ = true;
   return true;
 }
 
@@ -160,6 +174,8 @@ void World<S>::syncFromDevice() const {
   template std::string World<S>::deviceLimitation() const;                             \
   template std::string World<S>::setPhysicsPath(PhysicsPath, ParticleDeviceProvider*); \
   template bool World<S>::deviceParticlePass();                                        \
+  template bool World<S>::handDeviceTickBack();                                        \
+  template bool World<S>::devicePush(const GrassPushers<S>&, std::vector<int64_t>*);   \
   template bool World<S>::downloadDevicePatches(PatchArrays<S>*) const;                \
   template bool World<S>::deriveDevicePatches() const;                                 \
   template void World<S>::syncFromDevice() const;

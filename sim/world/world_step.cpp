@@ -138,17 +138,9 @@ bool World<S>::integrateStage() {
     return pbd ? advanceParticleRow<S, true>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_)
                : advanceParticleRow<S, false>(kernel, particles_, b, e, dvx, dvy, dvz, c, dispX_, dispY_, dispZ_);
   };
-  // On a device (world_device.cpp), with the response stage's grass push, unless the pass
-  // faulted: then the reference redoes the push and the pass from the tick's input and reports
-  // the fault (a push's under Stage::Response, as on the CPU).
-  bool onDevice = false;
-  if (device_) {
-    const bool pushed = devicePushPending_;
-    onDevice = deviceParticlePass();
-    devicePushPending_ = false;
-    if (pushed && !onDevice && !pushGrassOnHost(devicePushers_)) return false;
-    if (pushed && onDevice && grassDragDt_ > S(0) && !applyGrassDrag(devicePushedPerBody_)) return false;
-  }
+  // On a device (world_device.cpp), unless the pass faulted: then the reference below redoes the
+  // tick and reports the fault.
+  const bool onDevice = device_ && deviceParticlePass();
   const bool rowUniform = windSchedule_.rowUniform();
   const LatticeWindow& window = grid_.window;
   const bool moved =
