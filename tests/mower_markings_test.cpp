@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "tests/test_support.h"
 
@@ -75,6 +77,32 @@ TEST(Mower, CutsArePersistentStateSavedRestoredAndHashed) {
   std::memcpy(bad.data() + editsAt, ij, 16);
   World<Fx32> c(s, 1);
   EXPECT_THROW(c.restoreState(bad), StateError);
+}
+
+// A mower 14 km from a small fx16 lattice's origin: its lattice index (280,000 at 20 per metre)
+// is beyond Q16.16's range. It cuts nothing and must not fault: the index is the exact product's
+// floor (floorOfProduct), and a fault raised by the mowing or the grass pushers' set-up is taken
+// in the response stage, on the thread that raised it, for any thread count.
+TEST(Mower, FarFromAnFx16LatticeCutsNothingAndRaisesNoFault) {
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(test::sourcePath("scenarios/mower-field.json")));
+  j["scalar"] = "fx16";
+  j["field"]["patchesX"] = 20;
+  j["field"]["patchesZ"] = 20;
+  j["field"]["spacing"] = 0.05;
+  j["field"]["center"] = {-7000, 0};
+  j.erase("markings");
+  j["script"] = nlohmann::json::array();
+  j["bodies"]["list"][0]["position"] = {7000, 0.45, 2};
+  const Scenario s = parseScenario(j.dump(), "far-mower", {});
+  for (int threads : {1, 2}) {
+    World<Fx16> w(s, threads);
+    for (int t = 0; t < 30; ++t) {
+      const StepResult r = w.step(scriptedInput(s, w.tick()));
+      ASSERT_TRUE(r.ok) << "threads " << threads << ", tick " << t << ": " << r.error.what;
+      EXPECT_EQ(takeFixedFaults(), 0u) << "a fault left pending on the caller's thread";
+    }
+    EXPECT_TRUE(w.cuts().empty());
+  }
 }
 
 TEST(Markings, PatchesOnTheLinesShowTheMarkingTuft) {

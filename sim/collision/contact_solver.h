@@ -38,6 +38,7 @@
 // sequential solve in canonical order needs no colouring and converges as well.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "sim/bodies/rigid_body.h"
@@ -126,29 +127,44 @@ struct ContactRow {
   bool slidingAxes = false;  ///< t1 along the sliding velocity at prepare (else tangentOf(normal))
 };
 
-/// Builds the rows of `contacts` from the bodies as they are before this tick's gravity, and
-/// takes each contact's impulses from `cache` (last tick's, sorted by key): the entry of the same
-/// key, or else the nearest cached point of the same body pair within 1 cm (two coplanar box faces
-/// swap clipping features from tick to tick, and losing their impulses makes a stack walk).
+/// Builds rows [begin, end) of `contacts` (sized to them by the caller) from the bodies as they
+/// are before this tick's gravity, and takes each contact's impulses from `cache` (last tick's,
+/// sorted by key): the entry of the same key, or else the nearest cached point of the same body
+/// pair within 1 cm (two coplanar box faces swap clipping features from tick to tick, and losing
+/// their impulses makes a stack walk). [begin, end) must hold whole body pairs (nextPairStart):
+/// a pair's rows share their cache entries and their sliding rule, and ranges so cut build the
+/// same rows apart, or on different threads, as the whole list at once.
 template <class S>
 void prepareContacts(const std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
-                     const std::vector<CachedImpulse<S>>& cache, int substeps, std::vector<ContactRow<S>>& rows);
+                     const std::vector<CachedImpulse<S>>& cache, int substeps, std::vector<ContactRow<S>>& rows,
+                     size_t begin, size_t end);
 
-/// Applies every row's accumulated impulses (the start of each sub-step).
+/// The first row at or after i that starts a body pair (contacts sorted; contacts.size() past the end).
 template <class S>
-void warmStartContacts(std::vector<RigidBody<S>>& bodies, const std::vector<ContactRow<S>>& rows);
+size_t nextPairStart(const std::vector<Contact<S>>& contacts, size_t i);
 
-/// Sets every row's separationNow from its bodies' present poses: once before the solve sweeps
-/// and once before the relax sweeps of a sub-step, the only places the poses have moved (the
-/// sweeps change velocities only), instead of once per row in every sweep.
+/// What one island's sub-steps need besides its bodies, rows and SolverSettings.
 template <class S>
-void updateSeparations(const std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows);
+struct IslandStep {
+  Vec3<S> gravityH = Vec3<S>::Zero();  ///< m/s: g h, a sub-step's gravity
+  S maxAngularSpeed{};                 ///< rad/s (clampAngularSpeed)
+  S h{};                               ///< s: one sub-step
+};
 
-/// One sweep over all rows (after updateSeparations): the normal (soft when `useBias`; speculative rows always limit
-/// the approach to their current gap per sub-step), then Coulomb friction on two tangents within mu x normal impulse.
+/// The sub-steps of one island: `islandBodies` (ascending) and the rows that join them
+/// (`islandRows`, ascending: their canonical order). Each sub-step: gravity, the angular-speed cap
+/// and the gyroscopic term per awake body; warm start; the separations at the present poses;
+/// `solveIterations` sweeps with bias; positions integrated over h; the separations again;
+/// `relaxIterations` sweeps without bias. Then each awake body's world inverse inertia (read by
+/// the next prepare).
+/// Islands share no body (rows against the terrain join none: it does not move), so solving them
+/// one after another, or at the same time on different threads, gives the bits of one sweep over
+/// all rows in canonical order: every operation of an island reads and writes that island's
+/// bodies and rows only, in the same order as in the whole sequence.
 template <class S>
-void solveContacts(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows,
-                   const SolverSettings<S>& settings, bool useBias);
+void solveIsland(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows,
+                 std::span<const int32_t> islandBodies, std::span<const int32_t> islandRows,
+                 const SolverSettings<S>& settings, const IslandStep<S>& step);
 
 /// After the sub-steps: restitution against the impact velocity, where the contact pushed.
 template <class S>

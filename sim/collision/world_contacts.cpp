@@ -1,19 +1,74 @@
 // The body stages of World<S>: collision detection (body pairs through the selected broad
 // phase, then bodies against the terrain, with speculative contacts up to each body's reach this
 // tick) and the response (the soft step of sim/collision/contact_solver.h: sub-steps of gravity,
-// the gyroscopic term, warm start, solve, position integration and relax; then restitution and
+// the gyroscopic term, warm start, solve, position integration and relax, island by island and
+// on the pool's threads (solver_islands.h); then restitution and
 // damping; the continuous sweep of fast bodies against a heightmap; then mowing, and the grass
 // pushed out of every body, with optional grass drag).
 #include <cmath>
 
-#include "sim/bodies/gyroscopic.h"
 #include "sim/bodies/integrate_bodies.h"
 #include "sim/collision/body_pairs.h"
 #include "sim/collision/continuous_terrain.h"
+#include "sim/collision/solver_islands.h"
 #include "sim/world/world.h"
 #include "sim/world/world_rows.h"
 
 namespace sg {
+
+namespace {
+
+/// Runs work(c) for chunks [0, n) on the pool (inline when one thread or one chunk), and raises on
+/// this thread every fixed-point fault the chunks raised, with those pending before. Fault bits are
+/// sticky per thread: a chunk's are taken where it ran, so without this a fault raised on a worker
+/// was lost and one raised here was not. With it, bodiesFaulted sees the same bits, and makes the
+/// same report, for any thread count. The chunks must write disjoint data.
+template <class Work>
+void runCarryingFaults(ChunkPool& pool, int64_t n, Work&& work) {
+  if (pool.threads() == 1 || n < 2) {
+    for (int64_t c = 0; c < n; ++c) work(c);
+    return;
+  }
+  std::vector<uint32_t> faults(size_t(n), 0);
+  const uint32_t pending = takeFixedFaults();
+  pool.run(n, [&](int64_t c, int) {
+    takeFixedFaults();
+    work(c);
+    faults[size_t(c)] = takeFixedFaults();
+  });
+  uint32_t all = pending;
+  for (const uint32_t f : faults) all |= f;
+  if (all != 0) detail::raiseFixedFault(all);
+}
+
+/// Chunks of the body stages' parallel parts: at most a fixed count, as the particle rows'
+/// chunks, so the cuts are the same for any thread count (they decide only who does what; 16
+/// keeps 2 to 8 threads busy on islands of unequal size), and each worth at least
+/// kBodyChunkWeight (a body or a row each weighs 1, a row in the solve 4): a few bodies are not
+/// worth waking the pool for.
+constexpr int64_t kBodyChunks = 16;
+constexpr int64_t kBodyChunkWeight = 32;
+
+/// Cuts [0, items) into ranges of about equal weight (weight(k) per item; see kBodyChunks), each
+/// cut moved forward to where `allowed` holds. Only who does what depends on it, never a bit.
+template <class Weight, class Allowed>
+std::vector<size_t> balancedCuts(size_t items, Weight&& weight, Allowed&& allowed) {
+  int64_t total = 0;
+  for (size_t k = 0; k < items; ++k) total += weight(k);
+  const int64_t chunks = std::clamp<int64_t>(total / kBodyChunkWeight, 1, kBodyChunks);
+  std::vector<size_t> cuts{0};
+  int64_t done = 0;
+  for (size_t k = 0; k < items && int64_t(cuts.size()) < chunks; ++k) {
+    done += weight(k);
+    if (done * chunks < total * int64_t(cuts.size())) continue;
+    const size_t at = allowed(k + 1);
+    if (at > cuts.back() && at < items) cuts.push_back(at);
+  }
+  cuts.push_back(items);
+  return cuts;
+}
+
+}  // namespace
 
 template <class S>
 void World<S>::detectContacts() {
@@ -58,9 +113,19 @@ void World<S>::detectContacts() {
       }
     }
   }
-  for (size_t i = 0; i < bodies_.size(); ++i)
-    if (!bodies_[i].asleep)
-      collideBodyTerrain(int32_t(i), bodies_[i], terrain_, contacts_, speculativeDistance_ + reach[i]);
+  // Bodies against the terrain, in ranges of bodies on the pool, appended in body order (the
+  // order one pass over the bodies gives, which the stable sort keeps for equal keys).
+  const std::vector<size_t> cuts = balancedCuts(
+      bodies_.size(), [&](size_t i) { return int64_t(bodies_[i].asleep ? 0 : 1); }, [](size_t i) { return i; });
+  std::vector<std::vector<Contact<S>>> terrainContacts(cuts.size() - 1);
+  runCarryingFaults(*pool_, int64_t(cuts.size()) - 1, [&](int64_t c) {
+    for (size_t i = cuts[size_t(c)]; i < cuts[size_t(c) + 1]; ++i)
+      if (!bodies_[i].asleep)
+        collideBodyTerrain(int32_t(i), bodies_[i], terrain_, terrainContacts[size_t(c)],
+                           speculativeDistance_ + reach[i]);
+  });
+  for (const std::vector<Contact<S>>& list : terrainContacts)
+    contacts_.insert(contacts_.end(), list.begin(), list.end());
   sortContacts(contacts_);
 }
 
@@ -108,30 +173,42 @@ bool World<S>::bodiesFaulted(Stage stage) {
 }
 
 template <class S>
+void World<S>::prepareContactRows() {
+  contactRows_.resize(contacts_.size());
+  const std::vector<size_t> cuts = balancedCuts(
+      contacts_.size(), [](size_t) { return int64_t(1); }, [&](size_t i) { return nextPairStart(contacts_, i); });
+  runCarryingFaults(*pool_, int64_t(cuts.size()) - 1, [&](int64_t c) {
+    prepareContacts(bodies_, contacts_, impulseCache_, solver_.substeps, contactRows_, cuts[size_t(c)],
+                    cuts[size_t(c) + 1]);
+  });
+}
+
+template <class S>
+void World<S>::solveIslands() {
+  // Islands share no body: each one's sub-steps read and write its own bodies and rows only.
+  const SolverIslands islands = solverIslands(bodies_, contacts_);
+  const IslandStep<S> step{gravitySubstep_, maxAngularSpeed_, substepDt_};
+  const std::vector<size_t> cuts = balancedCuts(
+      islands.count(),
+      [&](size_t k) { return int64_t(islands.rowsOf(k).size()) * 4 + int64_t(islands.bodiesOf(k).size()); },
+      [](size_t k) { return k; });
+  runCarryingFaults(*pool_, int64_t(cuts.size()) - 1, [&](int64_t c) {
+    for (size_t k = cuts[size_t(c)]; k < cuts[size_t(c) + 1]; ++k)
+      solveIsland(bodies_, contactRows_, islands.bodiesOf(k), islands.rowsOf(k), solver_, step);
+  });
+}
+
+template <class S>
 bool World<S>::respondToContacts() {
   // Before gravity: the approach velocities.
-  prepareContacts(bodies_, contacts_, impulseCache_, solver_.substeps, contactRows_);
+  prepareContactRows();
   // Where each body starts the tick: the continuous sweep below tests the path from here.
   std::vector<Vec3<S>> start;
   if (!terrain_.flat()) {
     start.reserve(bodies_.size());
     for (const RigidBody<S>& b : bodies_) start.push_back(b.position);
   }
-  for (int sub = 0; sub < solver_.substeps; ++sub) {
-    applyGravity(bodies_, gravitySubstep_);
-    clampAngularSpeed(bodies_, maxAngularSpeed_);
-    applyGyroscopicTerm(bodies_, substepDt_);
-    warmStartContacts(bodies_, contactRows_);
-    updateSeparations(bodies_, contactRows_);
-    for (int it = 0; it < solver_.solveIterations; ++it) solveContacts(bodies_, contactRows_, solver_, true);
-    integrateBodyPositions(bodies_, substepDt_);
-    updateSeparations(bodies_, contactRows_);
-    for (int it = 0; it < solver_.relaxIterations; ++it) solveContacts(bodies_, contactRows_, solver_, false);
-  }
-  // The sub-steps turned the awake bodies' rotations only; their world inverse inertia is read at
-  // the next prepare (contact Jacobians), so it is computed once here, not in every sub-step.
-  for (RigidBody<S>& b : bodies_)
-    if (!b.asleep) b.updateInvInertiaWorld();
+  solveIslands();
   // Stored before restitution: the next tick warm-starts with the sub-step's resting impulse, not
   // with the one-off bounce (re-applied, it held a bounced ball on the ground for a tick).
   storeImpulses(bodies_, contacts_, contactRows_, solver_, impulseCache_);
@@ -143,6 +220,11 @@ bool World<S>::respondToContacts() {
   // Grass: pushed out of every body. On a device the push runs there (world_device.cpp): the
   // particles stay on the device; where it could not push, the host does, from the same state.
   const GrassPushers<S> pushers = prepareGrassPushers(bodies_, grid_, bodyParticle_);
+  // Faults of the mowing and the pushers' set-up were raised on this thread: taken here, before
+  // the push's chunks, each of which starts by clearing its thread's faults (a chunk that ran here
+  // lost them, one that ran on another thread left them pending: a report that depended on
+  // scheduling).
+  if (const uint32_t faults = takeFixedFaults()) return failWith(Stage::Response, faults);
   std::vector<int64_t> pushed;
   if (device_ && devicePush(pushers, &pushed)) return grassDragDt_ > S(0) ? applyGrassDrag(pushed) : true;
   return pushGrassOnHost(pushers);

@@ -18,12 +18,17 @@ void World<S>::mowGrass() {
       const BodyPart<S>& shape = body.parts[part];
       const Pose<S> pose = body.partPose(part);
       const S reach = shape.boundingRadius + lattice_.jitterAmplitude + lattice_.spacing;
-      const int64_t i0 = std::max<int64_t>(0, floorToInt((pose.position.x() - reach - lattice_.originX) * invSpacing));
-      const int64_t i1 = std::min<int64_t>(lattice_.patchesX - 1,
-                                           floorToInt((pose.position.x() + reach - lattice_.originX) * invSpacing) + 1);
-      const int64_t j0 = std::max<int64_t>(0, floorToInt((pose.position.z() - reach - lattice_.originZ) * invSpacing));
-      const int64_t j1 = std::min<int64_t>(lattice_.patchesZ - 1,
-                                           floorToInt((pose.position.z() + reach - lattice_.originZ) * invSpacing) + 1);
+      // floorOfProduct: a mower far from the lattice has an index beyond fx16's range (a mower
+      // 2 km off a 5 cm lattice: 40,000 > 32,767); the product overflowed there and raised a
+      // fault for a mower that cuts nothing.
+      const int64_t i0 =
+          std::max<int64_t>(0, floorOfProduct(S(pose.position.x() - reach - lattice_.originX), invSpacing));
+      const int64_t i1 = std::min<int64_t>(
+          lattice_.patchesX - 1, floorOfProduct(S(pose.position.x() + reach - lattice_.originX), invSpacing) + 1);
+      const int64_t j0 =
+          std::max<int64_t>(0, floorOfProduct(S(pose.position.z() - reach - lattice_.originZ), invSpacing));
+      const int64_t j1 = std::min<int64_t>(
+          lattice_.patchesZ - 1, floorOfProduct(S(pose.position.z() + reach - lattice_.originZ), invSpacing) + 1);
       // Roots come from the lattice, not the window: a mower cuts wherever it drives.
       for (int64_t j = j0; j <= j1; ++j)
         for (int64_t i = i0; i <= i1; ++i) {

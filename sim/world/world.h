@@ -154,6 +154,10 @@ class World final : public SimWorld {
   void dropCachedImpulses(size_t body);
   void detectContacts();
   bool respondToContacts();
+  /// The contact rows (prepareContacts), in ranges of whole body pairs on the pool.
+  void prepareContactRows();
+  /// The sub-steps of every awake island (solveIsland), on the pool when there are several.
+  void solveIslands();
   bool bodiesFaulted(Stage stage);
   void mowGrass();
   void serialise(class StateSink& sink) const;
