@@ -123,8 +123,8 @@ bool World<S>::devicePush(const GrassPushers<S>& pushers, std::vector<int64_t>* 
     device_->upload(particles_);
     hostAhead_ = false;
   }
-  // Faults already raised this tick (mowing, the pushers' ranges) are the CPU reference's to
-  // report or discard, as its rows meet them: the host pushes.
+  // The response stage has taken the faults of the mowing and the pushers' ranges before the push
+  // (respondToContacts); any still pending are the CPU reference's to report: the host pushes.
   if (pendingFixedFaults() != 0) return handDeviceTickBack();
   DevicePush<S> push;
   push.pushers = &pushers;
