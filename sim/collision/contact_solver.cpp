@@ -108,6 +108,11 @@ S axisVelocity(const std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row
 /// Applies an impulse p (N s) along the axis: +p to A, -p to B.
 template <class S>
 void applyAxisImpulse(std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row, const ContactAxis<S>& x, S p) {
+  // No impulse, no change: in fixed point adding the zero products leaves every bit as it was
+  // (a speculative row that does not close, warm-started at zero, is most of a pile's rows). Not
+  // for float and double, where -0 + 0 is +0: their bits stay those of the sum.
+  if constexpr (ScalarTraits<S>::isFixed)
+    if (p == S(0)) return;
   RigidBody<S>& A = bodies[size_t(row.a)];
   A.velocity += x.dir * (p * row.invMassA);
   A.angularVelocity += x.turnA * p;
@@ -379,6 +384,12 @@ template <class S>
 template <class S>
 [[gnu::always_inline]] inline void solveFriction(std::vector<RigidBody<S>>& bodies, ContactRow<S>& row) {
   const ContactAxis<S>& n = row.normal;
+  // A row without a normal impulse and without friction impulses ends this sweep without them:
+  // both branches below clamp to a cone of radius 0, so every total is 0 and nothing is applied.
+  // Fixed point skips the work (the speculative rows of a pile that do not close); float and
+  // double do it, as their clamped zeros may be -0.
+  if constexpr (ScalarTraits<S>::isFixed)
+    if (n.impulse == S(0) && row.t1.impulse == S(0) && row.t2.impulse == S(0)) return;
   // Friction: stop the sliding velocity, the tangent impulse kept inside the Coulomb cone
   // |t| <= mu x normal impulse. Per-axis clamps (a pyramid) gave up to sqrt(2) mu N along the
   // diagonals and not opposite the velocity: a box on a slope 27 deg off its tangent axes slid
