@@ -128,5 +128,27 @@ TEST(SolverIslands, AFaultInAnIslandIsReportedAsInTheSequence) {
   EXPECT_EQ(reports[2], reports[0]);
 }
 
+// The same for the terrain contacts, found per range of bodies on the pool: a body of the large
+// pile teleported 32,767 m down overflows Q16.16 in its terrain contact (its depth under the
+// ground), inside a range that a worker may run, while 200 bodies keep the ranges several.
+TEST(SolverIslands, AFaultInATerrainContactIsReportedAsInTheSequence) {
+  Scenario s = largePile();
+  s.scalar = ScalarKind::Fx16;
+  validateForScalar(s, s.scalar, 0);
+  const int64_t kOne = int64_t(1) << 32;
+  std::vector<std::string> reports;
+  for (const int threads : {1, 2}) {
+    World<Fx16> w(s, threads);
+    for (int t = 0; t < 10; ++t) ASSERT_TRUE(w.step(scriptedInput(s, w.tick())).ok);
+    TickInput drop = scriptedInput(s, w.tick());
+    drop.bodies.push_back(BodyCommand{150, BodyCommandKind::Teleport, {0, -32767 * kOne, 0}});
+    const StepResult r = w.step(drop);
+    ASSERT_FALSE(r.ok) << threads << " threads";
+    EXPECT_EQ(r.error.stage, Stage::Collision) << r.error.message();
+    reports.push_back(r.error.message());
+  }
+  EXPECT_EQ(reports[1], reports[0]);
+}
+
 }  // namespace
 }  // namespace sg
