@@ -123,9 +123,8 @@ bool World<S>::devicePush(const GrassPushers<S>& pushers, std::vector<int64_t>* 
     device_->upload(particles_);
     hostAhead_ = false;
   }
-  // The response stage has taken the faults of the mowing and the pushers' ranges before the push
-  // (respondToContacts); any still pending are the CPU reference's to report: the host pushes.
-  if (pendingFixedFaults() != 0) return handDeviceTickBack();
+  // No fault is pending here: respondToContacts took (and reported) those of the mowing and the
+  // pushers' set-up just before.
   DevicePush<S> push;
   push.pushers = &pushers;
   push.settings = &bodyParticle_;
