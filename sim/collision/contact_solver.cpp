@@ -94,32 +94,36 @@ ContactAxis<S> makeAxis(const Vec3<S>& dir, const RigidBody<S>& A, const Vec3<S>
 }
 
 /// Relative velocity of A against B along the axis (m/s).
+// Inlined (with applyAxisImpulse and dot3): called three times per row in every sweep, 16 sweeps
+// a tick by default; as calls they were a quarter of 1,000 rolling balls' instructions.
 template <class S>
-S axisVelocity(const std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row, const ContactAxis<S>& x) {
+[[gnu::always_inline]] inline S axisVelocity(const std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row,
+                                             const ContactAxis<S>& x) {
   const RigidBody<S>& A = bodies[size_t(row.a)];
-  S v = A.velocity.dot(x.dir) + A.angularVelocity.dot(x.armA);
+  S v = dot3(A.velocity, x.dir) + dot3(A.angularVelocity, x.armA);
   if (row.b != kTerrainBody) {
     const RigidBody<S>& B = bodies[size_t(row.b)];
-    v -= B.velocity.dot(x.dir) + B.angularVelocity.dot(x.armB);
+    v -= dot3(B.velocity, x.dir) + dot3(B.angularVelocity, x.armB);
   }
   return v;
 }
 
 /// Applies an impulse p (N s) along the axis: +p to A, -p to B.
 template <class S>
-void applyAxisImpulse(std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row, const ContactAxis<S>& x, S p) {
+[[gnu::always_inline]] inline void applyAxisImpulse(std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row,
+                                                    const ContactAxis<S>& x, S p) {
   // No impulse, no change: in fixed point adding the zero products leaves every bit as it was
   // (a speculative row that does not close, warm-started at zero, is most of a pile's rows). Not
   // for float and double, where -0 + 0 is +0: their bits stay those of the sum.
   if constexpr (ScalarTraits<S>::isFixed)
     if (p == S(0)) return;
   RigidBody<S>& A = bodies[size_t(row.a)];
-  A.velocity += x.dir * (p * row.invMassA);
-  A.angularVelocity += x.turnA * p;
+  addScaled(A.velocity, x.dir, S(p * row.invMassA));
+  addScaled(A.angularVelocity, x.turnA, p);
   if (row.b == kTerrainBody) return;
   RigidBody<S>& B = bodies[size_t(row.b)];
-  B.velocity -= x.dir * (p * row.invMassB);
-  B.angularVelocity -= x.turnB * p;
+  subtractScaled(B.velocity, x.dir, S(p * row.invMassB));
+  subtractScaled(B.angularVelocity, x.turnB, p);
 }
 
 }  // namespace
@@ -249,12 +253,13 @@ void turnSlidingPairs(const std::vector<uint8_t>& slides, const std::vector<S>& 
 /// A's anchor minus B's anchor in the world now. The terrain does not move: its anchor is a
 /// constant that cancels against ContactRow::anchorGap, so it is left out.
 template <class S>
-Vec3<S> anchorDifference(const std::vector<RigidBody<S>>& bodies, const ContactRow<S>& row) {
+[[gnu::always_inline]] inline Vec3<S> anchorDifference(const std::vector<RigidBody<S>>& bodies,
+                                                       const ContactRow<S>& row) {
   const RigidBody<S>& A = bodies[size_t(row.a)];
-  Vec3<S> d = A.position + A.rotation * row.localA;
+  Vec3<S> d = A.position + times3(A.rotation, row.localA);
   if (row.b == kTerrainBody) return d;
   const RigidBody<S>& B = bodies[size_t(row.b)];
-  return d - (B.position + B.rotation * row.localB);
+  return d - (B.position + times3(B.rotation, row.localB));
 }
 
 }  // namespace
@@ -331,7 +336,7 @@ void updateSeparations(const std::vector<RigidBody<S>>& bodies, std::vector<Cont
   // The anchors moved with their bodies since prepare.
   for (const int32_t i : order) {
     ContactRow<S>& row = rows[size_t(i)];
-    row.separationNow = row.separation + (anchorDifference(bodies, row) - row.anchorGap).dot(row.normal.dir);
+    row.separationNow = row.separation + dot3(Vec3<S>(anchorDifference(bodies, row) - row.anchorGap), row.normal.dir);
   }
 }
 

@@ -104,12 +104,12 @@ class Fixed {
   static constexpr Fixed min() noexcept { return fromRaw(std::numeric_limits<Raw>::min()); }
   static constexpr Fixed epsilon() noexcept { return fromRaw(1); }
 
-  friend constexpr Fixed operator+(Fixed a, Fixed b) noexcept {
+  [[gnu::always_inline]] friend constexpr Fixed operator+(Fixed a, Fixed b) noexcept {
     Raw r;
     if (__builtin_add_overflow(a.raw_, b.raw_, &r)) detail::raiseFixedFault(kFixedFaultOverflow);
     return fromRaw(r);
   }
-  friend constexpr Fixed operator-(Fixed a, Fixed b) noexcept {
+  [[gnu::always_inline]] friend constexpr Fixed operator-(Fixed a, Fixed b) noexcept {
     Raw r;
     if (__builtin_sub_overflow(a.raw_, b.raw_, &r)) detail::raiseFixedFault(kFixedFaultOverflow);
     return fromRaw(r);
@@ -117,7 +117,7 @@ class Fixed {
   friend constexpr Fixed operator-(Fixed a) noexcept { return Fixed() - a; }
   friend constexpr Fixed operator+(Fixed a) noexcept { return a; }
 
-  friend constexpr Fixed operator*(Fixed a, Fixed b) noexcept {
+  [[gnu::always_inline]] friend constexpr Fixed operator*(Fixed a, Fixed b) noexcept {
     // |a*b| <= 2^(2*kRawBits - 2): the wide product never overflows.
     return fromRaw(narrow(roundShift(Wide(a.raw_) * Wide(b.raw_))));
   }
@@ -181,7 +181,7 @@ class Fixed {
     return static_cast<Raw>(static_cast<Raw>(value) * kOneRaw);
   }
   /// Narrows a wide value to Raw, raising an overflow fault when it does not fit.
-  static constexpr Raw narrow(Wide w) noexcept {
+  [[gnu::always_inline]] static constexpr Raw narrow(Wide w) noexcept {
     if (w > Wide(std::numeric_limits<Raw>::max()) || w < Wide(std::numeric_limits<Raw>::min()))
       detail::raiseFixedFault(kFixedFaultOverflow);
     return static_cast<Raw>(w);  // modular since C++20: defined
@@ -189,7 +189,7 @@ class Fixed {
   /// p / 2^Frac rounded to nearest, ties away from zero. Requires |p| < 2^(2*kRawBits-1).
   /// For p < 0, -floor((|p| + h) / D) == floor((p + h - 1) / D) with D = 2h, so one add of the
   /// sign (0 or -1) and an arithmetic shift (floor) give the symmetric rounding without a branch.
-  static constexpr Wide roundShift(Wide p) noexcept {
+  [[gnu::always_inline]] static constexpr Wide roundShift(Wide p) noexcept {
     const Wide sign = p >> (2 * kRawBits - 1);  // 0 or -1 (arithmetic shift, defined in C++20)
     return (p + (Wide(1) << (Frac - 1)) + sign) >> Frac;
   }
