@@ -1,6 +1,7 @@
 #include "replay/scenario_files.h"
 
 #include "replay/input_file.h"
+#include "sim/scenario/json_bounds.h"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -25,7 +26,7 @@ Scenario loadScenarioFile(const std::string& path, std::vector<sgr::EmbeddedFile
         std::filesystem::path(name).is_absolute() ? std::filesystem::path(name) : dir / name;
     std::string expected;
     if (!readInputFile(p.string(), InputLimits::kHeightmapBytes, out, &expected)) {
-      *why = "'" + name + "' to be " + expected;
+      *why = "'" + echoText(name) + "' to be " + expected;  // a scenario's text: bounded
       return false;
     }
     if (files) files->push_back(sgr::EmbeddedFile{name, *out});

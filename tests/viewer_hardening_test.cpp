@@ -6,6 +6,9 @@
 // goes on. Never a crash, a hang (every run is under a timeout) or an unbounded allocation.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <csignal>
 
 #include <regex>
 #include <string>
@@ -364,6 +367,91 @@ TEST(ViewerHardening, SetTheGrassModelByItsNewName) {
   EXPECT_EQ(v.exitCode, 0) << v.describe();
   EXPECT_NE(v.out.find("error      -"), std::string::npos) << v.out;
   EXPECT_NE(v.out.find("state      tick 2,"), std::string::npos) << v.out;
+}
+
+// ---- round 4 (2026-11-28): an independent pass's hostile cases ------------------------------------
+
+/// `program args` under `ulimit -f 1` (1 KiB; SIGXFSZ left at its default, as a user's shell has
+/// it), stdout and stderr captured, with `xvfb-run` in front when `xvfb`.
+CliResult runWithFileLimit(const std::string& program, const std::string& args, bool xvfb) {
+  TempDir io;
+  const std::string stdoutFile = io.file("stdout"), stderrFile = io.file("stderr");
+  const std::string inner = "ulimit -f 1; exec " + quote(program) + " " + args;
+  const std::string cmd = "env TMPDIR=" + quote(io.file("")) + " timeout -k 5 120 " +
+                          (xvfb ? "xvfb-run -a -s '-screen 0 1024x768x24' " : "") + "bash -c " + quote(inner) +
+                          " </dev/null >" + quote(stdoutFile) + " 2>" + quote(stderrFile);
+  const int status = std::system(cmd.c_str());
+  CliResult r;
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.out = readFile(stdoutFile);
+  r.err = readFile(stderrFile);
+  return r;
+}
+
+TEST(ViewerHardening, AFileSizeLimitIsAFailedWriteForTheAtlasAndTheViewerNotASignal) {
+  // Both tools were killed by SIGXFSZ (exit 153 from bash) half-way through a PNG, leaving their
+  // temporary file; simgrass already ignored the signal and reported the failed write.
+  TempDir dir;
+  const CliResult atlas = runWithFileLimit(SIMGRASS_ATLAS, quote(dir.file("atlas")), false);
+  EXPECT_EQ(atlas.exitCode, 1) << atlas.describe();
+  EXPECT_TRUE(isOneLine(atlas.err)) << atlas.err;
+  for (const auto& entry : fs::directory_iterator(dir.file("atlas")))
+    EXPECT_EQ(entry.path().filename().string().rfind(".", 0), std::string::npos) << "left behind: " << entry.path();
+
+  if (!onPath("xvfb-run")) GTEST_SKIP() << "xvfb-run is not on PATH";
+  const std::string scenario = smallScenario(dir), shot = dir.file("shot.png");
+  const std::string script = dir.write("shot.txt", "frames 1\nscreenshot " + shot + "\nquit\n");
+  const CliResult v = runWithFileLimit(SIMGRASS_VIEWER, quote(scenario) + " --script " + quote(script) + kWindow, true);
+  EXPECT_NE(v.exitCode, 128 + SIGXFSZ) << v.describe();
+  EXPECT_NE(v.exitCode, 153) << v.describe();  // bash's 128 + 25 for a child killed by SIGXFSZ
+  EXPECT_NE(v.err.find("shot.png"), std::string::npos) << v.describe();
+  EXPECT_FALSE(fs::exists(shot));
+  for (const auto& entry : fs::directory_iterator(dir.path()))
+    EXPECT_EQ(entry.path().filename().string().find(".shot.png.tmp"), std::string::npos)
+        << "left behind: " << entry.path();
+}
+
+TEST(ViewerHardening, AtlasSeedOutOfRangeIsRefused) {
+  // CLI11 read "-1" as 2^64 - 1 and clamped 2^64 to it: three atlases of one seed without a word.
+  TempDir dir;
+  for (const char* seed : {"-1", "18446744073709551616", "99999999999999999999999", "1e3", "''"}) {
+    const std::string cmd = quote(SIMGRASS_ATLAS) + " " + quote(dir.file("a")) + " --seed " + seed + " 2>" +
+                            quote(dir.file("err")) + " >/dev/null";
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status)) << seed;
+    EXPECT_EQ(WEXITSTATUS(status), 2) << seed;
+    const std::string err = readFile(dir.file("err"));
+    EXPECT_TRUE(isOneLine(err)) << seed << ": " << err;
+    EXPECT_NE(err.find("--seed"), std::string::npos) << seed << ": " << err;
+  }
+  EXPECT_FALSE(fs::exists(dir.file("a")));
+  const std::string ok = quote(SIMGRASS_ATLAS) + " " + quote(dir.file("b")) + " --seed 18446744073709551615 >/dev/null";
+  EXPECT_EQ(std::system(ok.c_str()), 0);
+  EXPECT_TRUE(fs::exists(dir.file("b/tuft-atlas.png")));
+}
+
+TEST(ViewerHardening, RenderRefusesAnEmptyCameraAndEchoesALongMeshNameInSixtyCharacters) {
+  TempDir dir;
+  const std::string scenario = smallScenario(dir);
+  const CliResult camera =
+      runCli("render " + quote(scenario) + " -o " + quote(dir.file("frames")) + " --size 32x32 --msaa 0 --camera ''");
+  EXPECT_EQ(camera.exitCode, 2) << camera.describe();
+  EXPECT_TRUE(isOneLine(camera.err)) << camera.err;
+  EXPECT_NE(camera.err.find("--camera"), std::string::npos) << camera.err;
+
+  // A body's mesh name comes from the scenario: quoted in at most 60 characters like any text the
+  // scenario holds (it was echoed whole: a one-megabyte error line).
+  json j = json::parse(readFile(scenario));
+  j["bodies"]["list"] = json::array({json{{"name", "ball"},
+                                          {"shape", {{"type", "sphere"}, {"radius", 0.3}}},
+                                          {"position", {0, 0.3, 0}},
+                                          {"mesh", std::string(100000, 'z') + ".obj"}}});
+  const std::string meshScenario = dir.write("mesh.json", j.dump());
+  const CliResult mesh =
+      runCli("render " + quote(meshScenario) + " -o " + quote(dir.file("frames2")) + " --size 32x32 --msaa 0");
+  EXPECT_EQ(mesh.exitCode, 2) << mesh.describe();
+  EXPECT_TRUE(isOneLine(mesh.err)) << mesh.err.substr(0, 400);
+  EXPECT_LT(mesh.err.size(), meshScenario.size() + 300) << mesh.err.substr(0, 400);
 }
 
 }  // namespace

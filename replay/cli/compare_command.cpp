@@ -307,7 +307,12 @@ void addCompareCommand(CLI::App& app, int* exitCode) {
                   "model=blade (or thesis, pbd), threads=2, physics=gpu (or gpu-readback, cpu); "
                   "combine with commas (scalar=fx16,interp=2). Repeatable")
       ->required()
-      ->allow_extra_args(false);  // one value per --variant: `--variant interp=2 run.sgr` keeps run.sgr
+      ->allow_extra_args(false)  // one value per --variant: `--variant interp=2 run.sgr` keeps run.sgr
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            return v.empty() ? std::string("expected KEY=VALUE (got an empty value)") : std::string();
+          },
+          "KEY=VALUE"));
   cmd->add_option("--ticks", o->ticks, "Compare the first N ticks (default: the whole recording)")
       ->check(CLI::Range(int64_t(1), int64_t(1) << 40));
   cmd->add_option("--threads", o->threads, "Worker threads of the reference and of variants without threads=")

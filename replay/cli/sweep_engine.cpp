@@ -197,6 +197,9 @@ void listRows(Plan& plan) {
 }  // namespace
 
 Plan makePlan(const Options& o, bool measureTufts, const char* missingFileHint) {
+  // An empty list would sweep nothing and write an empty table (and a plan that --merge refuses).
+  if (splitList(o.scenarios).empty())
+    throw ScenarioError("--scenarios", "$", "a comma-separated list of scenario files (got an empty one)");
   Plan plan = planTimes(o);
   // A device path needs a device, and a scalar that has one (double has none).
   for (PhysicsPath physics : plan.axes.physics) {

@@ -1,6 +1,7 @@
 // simgrass-viewer: the interactive host (docs/viewer.md). main() only parses the command line,
 // reads the script, opens the input (a scenario, or a recording to play back, optionally A/B)
 // and hands everything to App (app.h), which owns the window and the frame loop.
+#include <csignal>
 #include <cstdio>
 
 #include "replay/input_file.h"
@@ -24,6 +25,9 @@ std::unique_ptr<sg::ParticleDeviceProvider> noDeviceBeforeTheWindow(std::string*
 int main(int argc, char** argv) {
   using namespace sg;
   using namespace sg::viewer;
+  // As simgrass: a file-size limit (ulimit -f) is a failed write the viewer reports (a screenshot,
+  // a recording), not SIGXFSZ killing it with a temporary file left behind.
+  std::signal(SIGXFSZ, SIG_IGN);
   if (!applyKernelEnvironment()) {
     std::fprintf(stderr, "simgrass-viewer: SIMGRASS_KERNEL: expected scalar, avx2 or auto\n");
     return kExitBadInput;

@@ -1,7 +1,9 @@
 // simgrass-atlas: writes the procedural tuft atlas and ground texture as PNGs
 // (OUTDIR/tuft-atlas.png, OUTDIR/ground-texture.png), e.g. for docs/images.
 #include <CLI/CLI.hpp>
+#include <charconv>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -10,16 +12,31 @@
 #include "viewer/render/atlas.h"
 
 int main(int argc, char** argv) {
+  // As simgrass: a file-size limit is a failed write reported below, not SIGXFSZ mid-PNG.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"Writes the procedural tuft atlas (tuft-atlas.png) and ground texture (ground-texture.png) into OUTDIR",
                "simgrass-atlas"};
   std::string outDir;
   int variants = 4;
   uint64_t seed = 1;
+  std::string seedText = "1";
   app.add_option("OUTDIR", outDir, "Directory to write the PNGs into (created if missing)")->required();
   app.add_option("--variants", variants, "Grass tuft variants (atlas columns, plus the marking tuft)")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
-  app.add_option("--seed", seed, "Seed of the procedural generation")->capture_default_str();
+  // Read as text and converted exactly: CLI11's unsigned conversion wraps "-1" and clamps values
+  // past 2^64 - 1, which then drew the atlas of another seed without a word.
+  app.add_option("--seed", seedText, "Seed of the procedural generation, 0 .. 2^64-1")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [&seed](std::string& v) {
+            const char* end = v.data() + v.size();
+            const auto [at, ec] = std::from_chars(v.data(), end, seed);
+            return v.empty() || ec != std::errc() || at != end
+                       ? std::string("expected an integer from 0 to 2^64-1, got '") + v.substr(0, 40) + "'"
+                       : std::string();
+          },
+          "SEED"));
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

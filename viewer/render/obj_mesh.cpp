@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "replay/input_file.h"
+#include "sim/scenario/json_bounds.h"
 
 namespace sg::viewer {
 namespace {
@@ -182,11 +183,14 @@ bool parseObjMesh(const std::string& text, const std::string& name, ObjMesh* out
 
 bool loadObjMesh(const std::string& path, ObjMesh* out, std::string* error) {
   std::string text, expected;
+  // The name comes from a scenario (bodies.list[i].mesh): echoed as every found text is, at most
+  // 60 characters (docs/robustness.md), not the megabyte a hostile scenario can give it.
+  const std::string shown = echoText(path);
   if (!readInputFile(path, InputLimits::kMeshBytes, &text, &expected)) {
-    *error = path + ":0: expected " + expected;
+    *error = shown + ":0: expected " + expected;
     return false;
   }
-  return parseObjMesh(text, path, out, error);
+  return parseObjMesh(text, shown, out, error);
 }
 
 }  // namespace sg::viewer

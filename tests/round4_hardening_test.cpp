@@ -1,0 +1,67 @@
+// Hostile inputs an independent pass found accepted or echoed unbounded (2026-11-28, round 4;
+// docs/robustness.md): a megabyte file name in a scenario, an empty --scenarios list, an empty
+// --variant. Each must be one line naming the place, and exit 2.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "tests/cli_support.h"
+#include "tests/test_support.h"
+
+namespace sg {
+namespace {
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+TEST(Round4Hardening, AMegabyteHeightmapNameIsEchoedInSixtyCharacters) {
+  // The name is the scenario's text: an error quotes at most 60 characters of what it found. The
+  // 1,000,000-character name used to be echoed whole, a one-megabyte error line.
+  TempDir dir;
+  const std::string name(100000, 'y');
+  const std::string scenario =
+      dir.write("long.json", R"({"field": {"patchesX": 6, "patchesZ": 6}, "terrain": {"type": "heightmap", "file": ")" +
+                                 name + R"(.png"}})");
+  const CliResult r = runCli("run " + quote(scenario) + " --ticks 1 --threads 1");
+  EXPECT_EQ(r.exitCode, 2) << r.describe();
+  EXPECT_TRUE(isOneLine(r.err)) << r.err.substr(0, 400);
+  EXPECT_TRUE(contains(r.err, "$.terrain.file")) << r.err.substr(0, 400);
+  // The scenario's own path, the JSON path, 60 characters of the name and the reason.
+  EXPECT_LT(r.err.size(), scenario.size() + 300) << r.err.substr(0, 400);
+}
+
+TEST(Round4Hardening, AnEmptyScenarioListIsRefused) {
+  // `--scenarios ''` swept nothing and wrote an empty table (and a plan that --merge refuses);
+  // `--scenarios ','` was already refused.
+  TempDir dir;
+  for (const std::string& tail :
+       {std::string(" --out ") + quote(dir.file("out")), std::string(" --plan ") + quote(dir.file("plan.json"))}) {
+    const CliResult r = runCli("sweep --scenarios '' --scalars fx32 --k 1 --dt 1/60 --lod off" + tail);
+    EXPECT_EQ(r.exitCode, 2) << tail << "\n" << r.describe();
+    EXPECT_TRUE(isOneLine(r.err)) << r.err;
+    EXPECT_TRUE(contains(r.err, "--scenarios")) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir.file("out"))) << "nothing is written for a refused sweep";
+  EXPECT_FALSE(fs::exists(dir.file("plan.json")));
+}
+
+TEST(Round4Hardening, AnEmptyVariantIsRefused) {
+  // `--variant ''` recorded with the scenario's own settings and compared a "(recorded settings)"
+  // row: an empty value where KEY=VALUE is required, as `--scalars ''` already was.
+  TempDir dir;
+  const std::string scenario = test::sourcePath("tests/data/sgr/tiny.json");
+  const std::string out = dir.file("v.sgr");
+  const CliResult record = runCli("record " + quote(scenario) + " --ticks 3 --threads 1 --variant '' -o " + quote(out));
+  EXPECT_EQ(record.exitCode, 2) << record.describe();
+  EXPECT_TRUE(isOneLine(record.err)) << record.err;
+  EXPECT_TRUE(contains(record.err, "--variant")) << record.err;
+  EXPECT_FALSE(fs::exists(out));
+
+  ASSERT_EQ(runCli("record " + quote(scenario) + " --ticks 3 --threads 1 -o " + quote(out)).exitCode, 0);
+  const CliResult compare = runCli("compare " + quote(out) + " --variant ''");
+  EXPECT_EQ(compare.exitCode, 2) << compare.describe();
+  EXPECT_TRUE(isOneLine(compare.err)) << compare.err;
+  EXPECT_TRUE(contains(compare.err, "--variant")) << compare.err;
+}
+
+}  // namespace
+}  // namespace sg
