@@ -16,6 +16,7 @@
 
 #include "tests/cli_support.h"
 #include "tests/test_support.h"
+#include "viewer/app/input_history.h"
 
 namespace sg {
 namespace viewer_test {
@@ -452,6 +453,37 @@ TEST(ViewerHardening, RenderRefusesAnEmptyCameraAndEchoesALongMeshNameInSixtyCha
   EXPECT_EQ(mesh.exitCode, 2) << mesh.describe();
   EXPECT_TRUE(isOneLine(mesh.err)) << mesh.err.substr(0, 400);
   EXPECT_LT(mesh.err.size(), meshScenario.size() + 300) << mesh.err.substr(0, 400);
+}
+
+TEST(ViewerHardening, TheSessionsInputHistoryGrowsWithChangesNotTicks) {
+  // A scripted `step 5000000` on a 6 x 6 meadow held 550 MB of per-tick inputs (and a step of
+  // 10^8 ten times that); the history now keeps runs of equal inputs.
+  viewer::InputHistory h;
+  TickInput quiet, moved;
+  moved.hasCamera = true;
+  moved.camera = {1, 2, 3};
+  for (int64_t t = 0; t < 5000000; ++t) h.push_back(quiet);
+  EXPECT_EQ(h.size(), 5000000);
+  EXPECT_EQ(h.runCount(), 1u);
+  h.push_back(moved);
+  h.push_back(moved);
+  h.push_back(quiet);
+  EXPECT_EQ(h.runCount(), 3u);
+  EXPECT_EQ(h[0], quiet);
+  EXPECT_EQ(h[4999999], quiet);
+  EXPECT_EQ(h[5000000], moved);
+  EXPECT_EQ(h[5000001], moved);
+  EXPECT_EQ(h[5000002], quiet);
+  // A new branch from tick 5000001: the old future goes, the run that started before it stays.
+  h.resize(5000001);
+  EXPECT_EQ(h.size(), 5000001);
+  EXPECT_EQ(h.runCount(), 2u);
+  EXPECT_EQ(h[5000000], moved);
+  h.push_back(quiet);
+  EXPECT_EQ(h[5000001], quiet);
+  h.resize(0);
+  EXPECT_EQ(h.size(), 0);
+  EXPECT_EQ(h.runCount(), 0u);
 }
 
 }  // namespace

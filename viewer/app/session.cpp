@@ -49,7 +49,7 @@ std::unique_ptr<Session> Session::rebuilt(const std::string& text, bool replayHi
   s->world = makeWorld(s->scenario, threads, physicalMemoryBytes());
   if (replayHistory)  // up to the live tick: inputs beyond it (after a step back) are not taken
     for (int64_t t = 0; t < world->tick(); ++t) {
-      const StepResult r = s->step(history[size_t(t)]);
+      const StepResult r = s->step(history[t]);
       if (!r.ok)
         throw ScenarioError(scenario.sourceName, "$",
                             "a scenario the session so far replays under (" + r.error.message() + ")");
@@ -60,7 +60,7 @@ std::unique_ptr<Session> Session::rebuilt(const std::string& text, bool replayHi
 StepResult Session::step(const TickInput& input) {
   const int64_t now = world->tick();
   if (now < historyEnd()) {  // a new branch from here: the old future goes, and its snapshots
-    history.resize(size_t(now));
+    history.resize(now);
     while (!snapshots_.empty() && snapshots_.back().first > now) snapshots_.pop_back();
   }
   history.push_back(input);
@@ -89,7 +89,7 @@ StepResult Session::step(const TickInput& input) {
 StepResult Session::replayNext() {
   const int64_t t = world->tick();
   if (t >= historyEnd()) return {};
-  StepResult r = world->step(history[size_t(t)], &clock);
+  StepResult r = world->step(history[t], &clock);
   if (r.ok) keepSnapshot();
   return r;
 }
@@ -131,7 +131,7 @@ bool Session::seek(int64_t t, bool* stopped, std::string* error) {
     }
   }
   while (world->tick() < t) {
-    const StepResult r = world->step(history[size_t(world->tick())], &clock);
+    const StepResult r = world->step(history[world->tick()], &clock);
     if (!r.ok) {
       *error = "replaying the session to tick " + std::to_string(t) + " faulted: " + r.error.message();
       return false;
@@ -168,7 +168,7 @@ bool Session::startRecording(const std::string& path, std::string* error) {
     // recording does not take: recording starts a new branch from here).
     const int64_t now = world->tick();
     for (int64_t t = 0; t < now; ++t) {
-      const StepResult r = rec->step(history[size_t(t)]);
+      const StepResult r = rec->step(history[t]);
       if (!r.ok) {
         *error = "catching up the recording faulted: " + r.error.message();
         return false;
@@ -182,7 +182,7 @@ bool Session::startRecording(const std::string& path, std::string* error) {
     world = std::move(fresh);
     recorder = std::move(rec);
     recordPath = path;
-    history.resize(size_t(now));
+    history.resize(now);
     while (!snapshots_.empty() && snapshots_.back().first > now) snapshots_.pop_back();
     return true;
   } catch (const std::exception& e) {

@@ -11,6 +11,7 @@
 #include "replay/recorder.h"
 #include "replay/stage_clock.h"
 #include "sim/world/world.h"
+#include "viewer/app/input_history.h"
 
 namespace sg::viewer {
 
@@ -20,7 +21,7 @@ class Session {
   std::vector<sgr::EmbeddedFile> files;
   std::string scenarioDir;  ///< folder the scenario's relative file names resolve against
   std::unique_ptr<SimWorld> world;
-  std::vector<TickInput> history;  ///< history[t]: the input of tick t
+  InputHistory history;  ///< history[t]: the input of tick t (runs of equal inputs)
   std::unique_ptr<Recorder> recorder;
   std::string recordPath;
   int threads = 1;
