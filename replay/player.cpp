@@ -202,6 +202,7 @@ VerifyReport Player::verify(const std::function<void(int64_t)>& progress) {
   if (recordedFault && report.ok && world_->tick() > recording_.end->tick) {
     report.ok = false;  // the recording faulted at end->tick, the replay stepped past it
     report.firstMismatchTick = recording_.end->tick + 1;
+    report.recordedFaultMissing = true;
   }
   return report;
 }

@@ -26,7 +26,10 @@ struct VerifyReport {
   int64_t checksVerified = 0;
   int64_t firstMismatchTick = -1;
   uint64_t expectedHash = 0, actualHash = 0;
-  std::optional<SimError> fault;  ///< the replay faulted where the recording did not (or vice versa)
+  std::optional<SimError> fault;  ///< the replay faulted where the recording did not
+  /// The recording's END says the step from its last tick faulted, and the replay stepped it
+  /// without a fault (firstMismatchTick is the tick after; no hash was compared there).
+  bool recordedFaultMissing = false;
 };
 
 class Player {

@@ -3,7 +3,11 @@
 // --variant. Each must be one line naming the place, and exit 2.
 #include <gtest/gtest.h>
 
+#include <xxhash.h>
+
+#include <cstring>
 #include <string>
+#include <vector>
 
 #include "tests/cli_support.h"
 #include "tests/test_support.h"
@@ -61,6 +65,40 @@ TEST(Round4Hardening, AnEmptyVariantIsRefused) {
   EXPECT_EQ(compare.exitCode, 2) << compare.describe();
   EXPECT_TRUE(isOneLine(compare.err)) << compare.err;
   EXPECT_TRUE(contains(compare.err, "--variant")) << compare.err;
+}
+
+TEST(Round4Hardening, AnEndThatClaimsAFaultTheReplayDoesNotMeetIsSaidSo) {
+  // The END chunk's fault flag set (its checksum recomputed) on a clean recording: the replay steps
+  // on past the last tick without a fault. That was reported as "hash mismatch at tick 25:
+  // recorded 0000000000000000, replayed 0000000000000000", two hashes nobody computed.
+  TempDir dir;
+  const std::string rec = dir.file("t.sgr");
+  ASSERT_EQ(runCli("record " + quote(test::sourcePath("tests/data/sgr/tiny.json")) + " --ticks 24 --threads 1 -o " +
+                   quote(rec))
+                .exitCode,
+            0);
+  std::vector<uint8_t> bytes = readBytes(rec);
+  bool forged = false;
+  for (size_t at = 12; at + 8 <= bytes.size();) {  // chunks: type, u32 length, payload, u64 XXH3
+    uint32_t length = 0;
+    std::memcpy(&length, bytes.data() + at + 4, 4);  // little-endian on the machines that run this
+    if (std::memcmp(bytes.data() + at, "END ", 4) == 0) {
+      bytes[at + 8 + 16] = 1;  // after the final tick and hash
+      const uint64_t sum = XXH3_64bits(bytes.data() + at, 8 + size_t(length));
+      std::memcpy(bytes.data() + at + 8 + length, &sum, 8);
+      forged = true;
+    }
+    at += 16 + size_t(length);
+  }
+  ASSERT_TRUE(forged);
+  writeBytes(rec, bytes);
+  const CliResult r = runCli("replay " + quote(rec) + " --verify");
+  EXPECT_EQ(r.exitCode, 1) << r.describe();
+  EXPECT_TRUE(isOneLine(r.err)) << r.err;
+  EXPECT_TRUE(
+      contains(r.err, "the recording says the step from tick 24 faulted; the replay stepped it without a fault"))
+      << r.err;
+  EXPECT_FALSE(contains(r.err, "0000000000000000")) << r.err;
 }
 
 }  // namespace
