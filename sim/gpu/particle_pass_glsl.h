@@ -111,6 +111,14 @@ void checkFinite(RAW a, RAW b, RAW c, RAW d, RAW e, RAW f) {
       isnan(e) || isinf(f) || isnan(f))
     overflowed = true;
 }
+// The end of a particle's step: within a saved state's range, |x| <= 2^48, as the CPU's
+// FloatTraits::inStateRange (NaN fails the compare). The integration checks finiteness only.
+void checkInRange(RAW a, RAW b, RAW c, RAW d, RAW e, RAW f) {
+  const RAW limit = 281474976710656.0;
+  if (!(abs(a) <= limit && abs(b) <= limit && abs(c) <= limit && abs(d) <= limit && abs(e) <= limit &&
+        abs(f) <= limit))
+    overflowed = true;
+}
 #elif FX32
 // ---- Q32.32 (fixed.h's Fx32: int64 raw, 128-bit wide) ---------------------------------------
 RAW addChecked(RAW a, RAW b) { RAW r = a + b; if (((a ^ r) & (b ^ r)) < 0l) overflowed = true; return r; }
@@ -199,6 +207,7 @@ RAW length3(RAW x, RAW y, RAW z) {
 
 #if !FLOAT
 void checkFinite(RAW a, RAW b, RAW c, RAW d, RAW e, RAW f) {}  // every fixed-point value is finite
+void checkInRange(RAW a, RAW b, RAW c, RAW d, RAW e, RAW f) {}  // and can be saved
 #endif
 
 )GLSL";
@@ -296,7 +305,7 @@ void main() {
   u = addChecked(u, mulChecked(subChecked(nx, predictedX), invDt));
   v = addChecked(v, mulChecked(subChecked(ny, predictedY), invDt));
   w = addChecked(w, mulChecked(subChecked(nz, predictedZ), invDt));
-  checkFinite(nx, ny, nz, u, v, w);
+  checkInRange(nx, ny, nz, u, v, w);
   if (overflowed) noteFault(integrationKey);
 #else
   RAW damping = tickData[1];
@@ -336,7 +345,7 @@ void main() {
   v = addChecked(v, mulChecked(subChecked(ny, y), invDt));
   w = addChecked(w, mulChecked(subChecked(nz, z), invDt));
 #endif
-  checkFinite(nx, ny, nz, u, v, w);
+  checkInRange(nx, ny, nz, u, v, w);
   if (overflowed) noteFault(projectionKey);
 #endif
 
@@ -605,7 +614,7 @@ bool pushInside(int part) {
   if (!pushOut(part, hold ? rod : RAW(0))) return true;
   if ((pushFlags & 8u) != 0u) atomicAdd(pushCount[pushInt[4 * part + 1]], 1u);
   if (hold) holdTip(bx, by, bz, partValue(part, 0), partValue(part, 2), rod);
-  checkFinite(px, py, pz, pu, pv, pw);
+  checkInRange(px, py, pz, pu, pv, pw);
   return !overflowed;
 }
 

@@ -47,6 +47,7 @@ struct FixedTraits {
   static double toDouble(Fx v) { return v.toDouble(); }
   static bool faultPending() { return pendingFixedFaults() != 0; }
   static bool isFinite(Fx) { return true; }
+  static bool inStateRange(Fx) { return true; }  ///< every fixed-point value can be saved
   using Bits = std::make_unsigned_t<typename Fx::RawType>;
   static Bits bits(Fx v) { return static_cast<Bits>(v.raw()); }
   static Fx fromBits(Bits b) { return Fx::fromRaw(static_cast<typename Fx::RawType>(b)); }
@@ -67,6 +68,11 @@ struct FloatTraits {
   static double toDouble(F v) { return double(v); }
   static bool faultPending() { return false; }
   static bool isFinite(F v) { return std::isfinite(v); }
+  /// Finite and within +-maxStateMagnitude: what a saved state may hold (NaN fails the compare).
+  /// The particle stages fault on anything else, as World::bodiesFaulted does for bodies: a
+  /// particle accelerated past 2^48 was stepped on and recorded into snapshots no replay could
+  /// read (an independent pass, 2026-11-28).
+  static bool inStateRange(F v) { return std::fabs(double(v)) <= maxStateMagnitude; }
   using Bits = B;
   static Bits bits(F v) {
     Bits b;

@@ -39,11 +39,6 @@ struct IeeeLanes<float> {
   SG_AVX2_IEEE static __m256i bits(V v) { return _mm256_castps_si256(v); }
   /// An integer v in every lane of the lane width.
   SG_AVX2_IEEE static __m256i level(int v) { return _mm256_set1_epi32(v); }
-  /// All lanes of every argument finite (x - x is 0 for finite x, NaN for inf and NaN).
-  SG_AVX2_IEEE static bool finite(V a, V b, V c) {
-    const V sum = _mm256_add_ps(_mm256_add_ps(_mm256_sub_ps(a, a), _mm256_sub_ps(b, b)), _mm256_sub_ps(c, c));
-    return _mm256_movemask_ps(_mm256_cmp_ps(sum, sum, _CMP_UNORD_Q)) == 0;
-  }
 };
 
 template <>
@@ -63,11 +58,34 @@ struct IeeeLanes<double> {
   SG_AVX2_IEEE static V select(V mask, V ifSet, V ifClear) { return _mm256_blendv_pd(ifClear, ifSet, mask); }
   SG_AVX2_IEEE static __m256i bits(V v) { return _mm256_castpd_si256(v); }
   SG_AVX2_IEEE static __m256i level(int v) { return _mm256_set1_epi64x(v); }
-  SG_AVX2_IEEE static bool finite(V a, V b, V c) {
-    const V sum = _mm256_add_pd(_mm256_add_pd(_mm256_sub_pd(a, a), _mm256_sub_pd(b, b)), _mm256_sub_pd(c, c));
-    return _mm256_movemask_pd(_mm256_cmp_pd(sum, sum, _CMP_UNORD_Q)) == 0;
+  /// |a| <= limit per lane (an ordered compare: NaN fails it), all lanes of a mask, a and b.
+  SG_AVX2_IEEE static V withinMagnitude(V a, V limit) {
+    return _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), a), limit, _CMP_LE_OQ);
   }
+  SG_AVX2_IEEE static V both(V a, V b) { return _mm256_and_pd(a, b); }
+  SG_AVX2_IEEE static bool allLanes(V mask) { return _mm256_movemask_pd(mask) == 0xf; }
 };
+
+/// All lanes of a, b and c within a saved state's range, |x| <= 2^48 (FloatTraits::inStateRange):
+/// an infinity and a NaN fail it too.
+template <class W>
+SG_AVX2_IEEE bool inStateRange(typename W::V a, typename W::V b, typename W::V c) {
+  if constexpr (W::kCount == 8) {  // float
+    // float: the magnitude's bits (sign cleared) order as the magnitudes do, and an infinity's or
+    // a NaN's exceed every finite one's, so one integer maximum and one compare test all three:
+    // as many operations as the finiteness test this replaced (the float tick's instruction count
+    // is gated). 0x57800000 is 2^48's bits (exponent 127 + 48).
+    const __m256i magnitude = _mm256_set1_epi32(0x7fffffff);
+    const __m256i most = _mm256_max_epi32(_mm256_max_epi32(_mm256_and_si256(_mm256_castps_si256(a), magnitude),
+                                                           _mm256_and_si256(_mm256_castps_si256(b), magnitude)),
+                                          _mm256_and_si256(_mm256_castps_si256(c), magnitude));
+    return _mm256_movemask_epi8(_mm256_cmpgt_epi32(most, _mm256_set1_epi32(0x57800000))) == 0;
+  } else {
+    const typename W::V limit = W::all(281474976710656.0);  // 2^48, exact in double
+    return W::allLanes(
+        W::both(W::both(W::withinMagnitude(a, limit), W::withinMagnitude(b, limit)), W::withinMagnitude(c, limit)));
+  }
+}
 
 }  // namespace sg::avx2
 

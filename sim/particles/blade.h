@@ -92,8 +92,8 @@ inline int64_t advanceBladeRowScalar(ParticleArrays<S>& p, int64_t begin, int64_
     px[i] = nx;
     py[i] = ny;
     pz[i] = nz;
-    if (T::faultPending() || !(T::isFinite(nx) && T::isFinite(ny) && T::isFinite(nz) && T::isFinite(vx[i]) &&
-                               T::isFinite(vy[i]) && T::isFinite(vz[i])))
+    if (T::faultPending() || !(T::inStateRange(nx) && T::inStateRange(ny) && T::inStateRange(nz) &&
+                               T::inStateRange(vx[i]) && T::inStateRange(vy[i]) && T::inStateRange(vz[i])))
       return i;
   }
   particleDisplacement(p, begin, end, rod, dx, dy, dz);

@@ -67,7 +67,8 @@ bool World<S>::runParticleRows(Stage stage, Fn&& rowKernel) {
     failure_.particle = q;
     failure_.latticeI = grid_.window.latticeColumn(q % grid_.countX) * grid_.k;
     failure_.latticeJ = grid_.window.latticeRow(q / grid_.countX) * grid_.k;
-    failure_.what = faultBits[size_t(c)] ? fixedFaultName(faultBits[size_t(c)]) : "non-finite value";
+    failure_.what = faultBits[size_t(c)] ? fixedFaultName(faultBits[size_t(c)])
+                                         : "a value that is not finite or beyond +-2^48 (a saved state's range)";
     return false;
   }
   return true;
