@@ -123,6 +123,10 @@ VerifyResult verifyRecording(const std::string& path, int threads) {
   result.expectedHash = report.expectedHash;
   result.actualHash = report.actualHash;
   if (report.fault) result.error = report.fault->message();
+  result.recordedFaultMissing = report.recordedFaultMissing;
+  if (report.recordedFaultMissing)
+    result.error = "the recording says the step from tick " + std::to_string(rec.end->tick) +
+                   " faulted; the replay stepped it without a fault";
   result.finalHash = player.world().stateHash();
   return result;
 }

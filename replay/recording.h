@@ -110,8 +110,11 @@ struct VerifyResult {
   int64_t hashesChecked = 0;  ///< hashed ticks that matched (RecordingInfo::hashedTicks when all did)
   int64_t firstMismatchTick = -1;
   uint64_t expectedHash = 0, actualHash = 0;  ///< at firstMismatchTick, for a hash mismatch
-  std::string error;                          ///< the replay faulted where the recording did not
-  uint64_t finalHash = 0;                     ///< the replayed state's hash where the replay stopped
+  std::string error;  ///< the replay faulted where the recording did not, or the reverse (below)
+  /// The recording says its last step faulted and the replay stepped it without a fault (no hash
+  /// was compared there: expectedHash and actualHash stay 0).
+  bool recordedFaultMissing = false;
+  uint64_t finalHash = 0;  ///< the replayed state's hash where the replay stopped
 };
 
 /// Rebuilds the recorded world and replays it from start to end (`simgrass replay --verify`).

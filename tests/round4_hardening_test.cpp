@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "replay/recording.h"
 #include "tests/cli_support.h"
 #include "tests/test_support.h"
 
@@ -99,6 +100,12 @@ TEST(Round4Hardening, AnEndThatClaimsAFaultTheReplayDoesNotMeetIsSaidSo) {
       contains(r.err, "the recording says the step from tick 24 faulted; the replay stepped it without a fault"))
       << r.err;
   EXPECT_FALSE(contains(r.err, "0000000000000000")) << r.err;
+  // The library says the same (verifyRecording, what the CLI is built on).
+  const VerifyResult v = verifyRecording(rec, 1);
+  EXPECT_FALSE(v.ok);
+  EXPECT_TRUE(v.recordedFaultMissing);
+  EXPECT_EQ(v.firstMismatchTick, 25);
+  EXPECT_TRUE(contains(v.error, "the replay stepped it without a fault")) << v.error;
 }
 
 TEST(Round4Hardening, AFloatParticlePast2To48FaultsAndWhatWasRecordedReplays) {

@@ -453,6 +453,7 @@ TEST(ViewerHardening, RenderRefusesAnEmptyCameraAndEchoesALongMeshNameInSixtyCha
   EXPECT_EQ(mesh.exitCode, 2) << mesh.describe();
   EXPECT_TRUE(isOneLine(mesh.err)) << mesh.err.substr(0, 400);
   EXPECT_LT(mesh.err.size(), meshScenario.size() + 300) << mesh.err.substr(0, 400);
+  EXPECT_NE(mesh.err.find("zzzz.obj"), std::string::npos) << "the end of the path, with the file name, is shown";
 }
 
 TEST(ViewerHardening, TheSessionsInputHistoryGrowsWithChangesNotTicks) {

@@ -299,7 +299,10 @@ int64_t pushParticlesOutOfBodies(ParticleArrays<S>& pa, const ParticleGrid& grid
     if (!pushOut(pa, i, pusher, s.boxNormal, s.holdTips ? s.rodLength : S(0))) return true;
     if (pushedPerBody) ++pushedPerBody[pusher.body];
     if (s.holdTips) holdTip(pa, i, before, pusher.pose.position, s.rodLength);
-    return !T::faultPending() && T::inStateRange(pa.px[i]) && T::inStateRange(pa.py[i]) && T::inStateRange(pa.pz[i]);
+    // The velocities too: holdTip takes the normal part off a tip's velocity, which can raise one
+    // component (the device's push checks all six, as here).
+    return !T::faultPending() && T::inStateRange(pa.px[i]) && T::inStateRange(pa.py[i]) && T::inStateRange(pa.pz[i]) &&
+           T::inStateRange(pa.vx[i]) && T::inStateRange(pa.vy[i]) && T::inStateRange(pa.vz[i]);
   };
   // Storage rows [rowBegin, rowEnd): each holds one lattice row of the window. Per particle the
   // parts apply in (body, part) order, as the bucket keeps them: the same bits as any order of

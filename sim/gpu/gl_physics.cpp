@@ -249,7 +249,7 @@ class GlParticleDevice final : public ParticleDevice<S> {
       return {};
     }
     // The only fixed-point fault the pass can raise (no d = 0 division, no negative root); a float
-    // pass faults on a non-finite value, which has no fault bits.
+    // pass faults on a value that is not finite or beyond +-2^48, which has no fault bits.
     *faultBits = std::is_same_v<S, float> ? 0u : uint32_t(kFixedFaultOverflow);
     return decode(key, wind);
   }

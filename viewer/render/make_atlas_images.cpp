@@ -9,6 +9,7 @@
 #include <string>
 #include <system_error>
 
+#include "sim/scenario/json_bounds.h"
 #include "viewer/render/atlas.h"
 
 int main(int argc, char** argv) {
@@ -33,7 +34,7 @@ int main(int argc, char** argv) {
             const char* end = v.data() + v.size();
             const auto [at, ec] = std::from_chars(v.data(), end, seed);
             return v.empty() || ec != std::errc() || at != end
-                       ? std::string("expected an integer from 0 to 2^64-1, got '") + v.substr(0, 40) + "'"
+                       ? "expected an integer from 0 to 2^64-1, got '" + sg::echoText(v) + "'"
                        : std::string();
           },
           "SEED"));

@@ -181,11 +181,25 @@ bool parseObjMesh(const std::string& text, const std::string& name, ObjMesh* out
   return true;
 }
 
+namespace {
+/// A mesh path as an error shows it: whole up to 60 bytes, else "..." and its last 57 bytes (cut
+/// at a UTF-8 boundary), escaped as every echo is. The end, because the path is the scenario's
+/// folder joined to the name the scenario gives, and the file name is what tells the reader
+/// which mesh.
+std::string shownPath(const std::string& path) {
+  constexpr size_t kWhole = 60, kTail = 57;
+  if (path.size() <= kWhole) return echoText(path);
+  size_t from = path.size() - kTail;
+  while (from < path.size() && (uint8_t(path[from]) & 0xC0) == 0x80) ++from;  // not inside a character
+  return "..." + echoText(path.substr(from));
+}
+}  // namespace
+
 bool loadObjMesh(const std::string& path, ObjMesh* out, std::string* error) {
   std::string text, expected;
-  // The name comes from a scenario (bodies.list[i].mesh): echoed as every found text is, at most
-  // 60 characters (docs/robustness.md), not the megabyte a hostile scenario can give it.
-  const std::string shown = echoText(path);
+  // The name comes from a scenario (bodies.list[i].mesh): bounded as every found text is
+  // (docs/robustness.md), not the megabyte a hostile scenario can give it.
+  const std::string shown = shownPath(path);
   if (!readInputFile(path, InputLimits::kMeshBytes, &text, &expected)) {
     *error = shown + ":0: expected " + expected;
     return false;
