@@ -4,6 +4,7 @@
 
 #include "replay/physics_devices.h"
 #include "replay/scenario_files.h"
+#include "sim/scenario/json_bounds.h"
 
 namespace sg {
 
@@ -205,6 +206,12 @@ VerifyReport Player::verify(const std::function<void(int64_t)>& progress) {
     report.recordedFaultMissing = true;
   }
   return report;
+}
+
+std::string describeRecordedFaultMissing(const sgr::EndInfo& end) {
+  return "the recording says the step from tick " + std::to_string(end.tick) + " faulted" +
+         (end.message.empty() ? std::string() : " (" + echoText(end.message) + ")") +
+         "; the replay stepped it without a fault";
 }
 
 }  // namespace sg

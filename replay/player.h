@@ -32,6 +32,10 @@ struct VerifyReport {
   bool recordedFaultMissing = false;
 };
 
+/// What a verify says when VerifyReport::recordedFaultMissing: the step from `end.tick` that the
+/// recording says faulted (with its message, if it has one, echoed bounded) stepped cleanly.
+std::string describeRecordedFaultMissing(const sgr::EndInfo& end);
+
 class Player {
  public:
   /// Builds the world. With a non-empty `variant`, the recorded inputs drive a different setup

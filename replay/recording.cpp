@@ -124,9 +124,7 @@ VerifyResult verifyRecording(const std::string& path, int threads) {
   result.actualHash = report.actualHash;
   if (report.fault) result.error = report.fault->message();
   result.recordedFaultMissing = report.recordedFaultMissing;
-  if (report.recordedFaultMissing)
-    result.error = "the recording says the step from tick " + std::to_string(rec.end->tick) +
-                   " faulted; the replay stepped it without a fault";
+  if (report.recordedFaultMissing) result.error = describeRecordedFaultMissing(*rec.end);
   result.finalHash = player.world().stateHash();
   return result;
 }

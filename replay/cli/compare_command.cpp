@@ -9,6 +9,7 @@
 
 #include "replay/cli/cli_common.h"
 #include "replay/cli/divergence_report.h"
+#include "replay/cli/option_checks.h"
 #include "replay/divergence.h"
 #include "replay/lockstep.h"
 #include "replay/progress.h"
@@ -308,11 +309,7 @@ void addCompareCommand(CLI::App& app, int* exitCode) {
                   "combine with commas (scalar=fx16,interp=2). Repeatable")
       ->required()
       ->allow_extra_args(false)  // one value per --variant: `--variant interp=2 run.sgr` keeps run.sgr
-      ->check(CLI::Validator(
-          [](std::string& v) {
-            return v.empty() ? std::string("expected KEY=VALUE (got an empty value)") : std::string();
-          },
-          "KEY=VALUE"));
+      ->check(nonEmptyValue("KEY=VALUE", "KEY=VALUE"));
   cmd->add_option("--ticks", o->ticks, "Compare the first N ticks (default: the whole recording)")
       ->check(CLI::Range(int64_t(1), int64_t(1) << 40));
   cmd->add_option("--threads", o->threads, "Worker threads of the reference and of variants without threads=")

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "replay/cli/cli_common.h"
+#include "replay/cli/option_checks.h"
 #include "replay/input_file.h"
 #include "replay/physics_devices.h"
 #include "replay/progress.h"
@@ -216,11 +217,7 @@ void addRecordCommand(CLI::App& app, int* exitCode) {
                   "Settings over the scenario: scalar=fx16, interp=2, broadphase=brute, "
                   "body-broadphase=sap, dt=1/120, lod=off, model=blade, physics=gpu (repeatable)")
       ->allow_extra_args(false)  // one value per --variant: a scenario path after it stays the scenario
-      ->check(CLI::Validator(
-          [](std::string& v) {
-            return v.empty() ? std::string("expected KEY=VALUE (got an empty value)") : std::string();
-          },
-          "KEY=VALUE"));
+      ->check(nonEmptyValue("KEY=VALUE", "KEY=VALUE"));
   // The same flags as `simgrass run`, each a shorthand for --variant KEY=VALUE.
   o->shorthands = {{"scalar", ""}, {"interp", ""}, {"broadphase", ""}, {"body-broadphase", ""},
                    {"lod", ""},    {"dt", ""},     {"model", ""},      {"physics", ""}};

@@ -137,10 +137,7 @@ int replay(const ReplayOptions& o) {
           // No hash to show: the recording holds none for the tick after its last. A forged or
           // damaged END fault flag gave "hash mismatch at tick 25: recorded 0000000000000000,
           // replayed 0000000000000000" here (an independent pass).
-          const std::string& said = rec->end->message;
-          const std::string what = "the recording says the step from tick " + std::to_string(rec->end->tick) +
-                                   " faulted" + (said.empty() ? std::string() : " (" + echoText(said) + ")") +
-                                   "; the replay stepped it without a fault";
+          const std::string what = describeRecordedFaultMissing(*rec->end);
           out["error"] = what;
           printError("simgrass replay: %s: %s\n", o.file.c_str(), what.c_str());
         } else {

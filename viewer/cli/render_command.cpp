@@ -18,6 +18,7 @@
 #include <sstream>
 
 #include "replay/cli/cli_common.h"
+#include "replay/cli/option_checks.h"
 #include "replay/format/sgr_format.h"
 #include "replay/format/sgr_reader.h"
 #include "replay/input_file.h"
@@ -549,11 +550,7 @@ void addRenderCommand(CLI::App& app, int* exitCode) {
                   "input's camera track if any, else a view framing the bodies at the first frame rendered (25 degrees "
                   "above, from -z), else 1.7 m above the ground at the -z edge of the simulated grass, looking at its "
                   "centre")
-      ->check(CLI::Validator(
-          [](std::string& v) {
-            return v.empty() ? std::string("expected x,y,z,yaw,pitch (got an empty value)") : std::string();
-          },
-          "X,Y,Z,YAW,PITCH"));
+      ->check(nonEmptyValue("x,y,z,yaw,pitch", "X,Y,Z,YAW,PITCH"));
   cmd->add_option("--msaa", o->msaa, "Samples per pixel: 0 (alpha test) or 2/4/8 (alpha to coverage; default 4)");
   cmd->add_flag("--ssao", o->ssao,
                 "Screen-space ambient occlusion (depth prepass where the tufts' alpha passes, half resolution)");
