@@ -240,6 +240,12 @@ const std::vector<BadCase> kValueCases = {
     {"TipContactUnknown", R"({"bodies": {"tipContact": "stick"}})", "$.bodies.tipContact",
      "one of \"push\", \"hold\", got \"stick\""},
     {"ContactHertzNegative", R"({"bodies": {"contactHertz": -60}})", "$.bodies.contactHertz", "positive"},
+    {"IslandSweepsZero", R"({"bodies": {"islandVelocityIterations": 0}})", "$.bodies.islandVelocityIterations",
+     "an integer"},
+    {"IslandSweepsTooMany", R"({"bodies": {"islandVelocityIterations": 1001}})", "$.bodies.islandVelocityIterations",
+     "an integer"},
+    {"IslandSweepsFraction", R"({"bodies": {"islandVelocityIterations": 2.5}})", "$.bodies.islandVelocityIterations",
+     "an integer"},
     {"SpacingNegative", R"({"field": {"spacing": -0.25}})", "$.field.spacing", "positive"},
     {"SpacingNegativeFraction", R"({"field": {"spacing": "-1/4"}})", "$.field.spacing", "positive"},
     {"SpacingZeroFraction", R"({"field": {"spacing": "0/5"}})", "$.field.spacing", "positive"},
@@ -403,6 +409,9 @@ TEST(ScenarioParse, AcceptsBoundaryValues) {
   EXPECT_EQ(s.particles.damping, (Rational{1, 1}));
   EXPECT_TRUE(s.wind.schedule.empty());
   EXPECT_EQ(parse(R"({"timeStep": "1/100000"})").timeStep, (Rational{1, 100000}));
+  EXPECT_EQ(parse(R"({"bodies": {"islandVelocityIterations": 1}})").bodies.islandVelocityIterations, 1);
+  EXPECT_EQ(parse(R"({"bodies": {"islandVelocityIterations": 1000}})").bodies.islandVelocityIterations, 1000);
+  EXPECT_EQ(parse("{}").bodies.islandVelocityIterations, 6);
 }
 
 TEST(ScenarioParse, NumbersAreExactFromTheirText) {

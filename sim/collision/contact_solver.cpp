@@ -455,6 +455,11 @@ template <class S>
 void solveIsland(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows,
                  std::span<const int32_t> islandBodies, std::span<const int32_t> islandRows,
                  const SolverSettings<S>& settings, const IslandStep<S>& step) {
+  // A body alone settles against the terrain in a few sweeps; touching bodies pass a correction on
+  // one contact per sweep, and a heavy or wide body on a lighter one needs more (physics-notes.md,
+  // "A wide load on a narrower, lighter support"). Chosen per island from what it holds, never from
+  // the thread that solves it, so the bits stay the sequence's.
+  const int solveSweeps = islandBodies.size() > 1 ? settings.islandSolveIterations : settings.solveIterations;
   for (int sub = 0; sub < settings.substeps; ++sub) {
     for (const int32_t b : islandBodies) {
       RigidBody<S>& body = bodies[size_t(b)];
@@ -464,7 +469,7 @@ void solveIsland(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& 
     }
     warmStartContacts(bodies, rows, islandRows);
     updateSeparations(bodies, rows, islandRows);
-    for (int it = 0; it < settings.solveIterations; ++it) solveContacts(bodies, rows, islandRows, settings, true);
+    for (int it = 0; it < solveSweeps; ++it) solveContacts(bodies, rows, islandRows, settings, true);
     for (const int32_t b : islandBodies) integrateBodyPosition(bodies[size_t(b)], step.h);
     updateSeparations(bodies, rows, islandRows);
     for (int it = 0; it < settings.relaxIterations; ++it) solveContacts(bodies, rows, islandRows, settings, false);

@@ -63,12 +63,13 @@ Softness<S> makeSoftness(S hertz, S zeta, S h, S pi);
 
 template <class S>
 struct SolverSettings {
-  int substeps = 4;          ///< sub-steps per tick (the scenario's bodies.substeps)
-  int solveIterations = 3;   ///< solve sweeps per sub-step (bodies.velocityIterations)
-  int relaxIterations = 1;   ///< relax sweeps per sub-step (bodies.positionIterations)
-  S restitutionThreshold{};  ///< m/s
-  S maxPushVelocity{};       ///< m/s: the fastest a soft contact pushes overlap out
-  S linearSlop{};            ///< m: deeper overlap keeps a body awake (settings::kLinearSlop)
+  int substeps = 4;               ///< sub-steps per tick (the scenario's bodies.substeps)
+  int solveIterations = 3;        ///< solve sweeps per sub-step of a body alone (bodies.velocityIterations)
+  int islandSolveIterations = 6;  ///< of an island of 2+ bodies (bodies.islandVelocityIterations, >= the above)
+  int relaxIterations = 1;        ///< relax sweeps per sub-step (bodies.positionIterations)
+  S restitutionThreshold{};       ///< m/s
+  S maxPushVelocity{};            ///< m/s: the fastest a soft contact pushes overlap out
+  S linearSlop{};                 ///< m: deeper overlap keeps a body awake (settings::kLinearSlop)
   /// s: 1 / (h omega^2) of body-body and terrain contacts. A soft contact carrying the normal
   /// impulse P per sub-step gives way by P / (m h omega^2), m its effective mass, at rest: that
   /// much overlap is its load, not a push-out (storeImpulses' sleep rule).
@@ -154,13 +155,15 @@ struct IslandStep {
 /// The sub-steps of one island: `islandBodies` (ascending) and the rows that join them
 /// (`islandRows`, ascending: their canonical order). Each sub-step: gravity, the angular-speed cap
 /// and the gyroscopic term per awake body; warm start; the separations at the present poses;
-/// `solveIterations` sweeps with bias; positions integrated over h; the separations again;
-/// `relaxIterations` sweeps without bias. Then each awake body's world inverse inertia (read by
-/// the next prepare).
+/// `solveIterations` sweeps with bias (`islandSolveIterations` for an island of two or more
+/// bodies); positions integrated over h; the separations again; `relaxIterations` sweeps without
+/// bias. Then each awake body's world inverse inertia (read by the next prepare).
 /// Islands share no body (rows against the terrain join none: it does not move), so solving them
-/// one after another, or at the same time on different threads, gives the bits of one sweep over
-/// all rows in canonical order: every operation of an island reads and writes that island's
-/// bodies and rows only, in the same order as in the whole sequence.
+/// one after another, or at the same time on different threads, gives the same bits: every
+/// operation of an island reads and writes that island's bodies and rows only, in canonical
+/// order. (With one sweep count for all, that is the bits of one sweep over all rows; the code
+/// before islands did that, and tests/data/solver_pile*.json keep its hashes at
+/// "islandVelocityIterations": 3.)
 template <class S>
 void solveIsland(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<S>>& rows,
                  std::span<const int32_t> islandBodies, std::span<const int32_t> islandRows,

@@ -1,5 +1,6 @@
 #include "sim/scenario/fingerprint.h"
 
+#include <algorithm>
 #include <initializer_list>
 
 #include "sim/state/state_sink.h"
@@ -63,8 +64,12 @@ uint64_t scenarioFingerprint(const Scenario& s) {
                 int64_t(b.list.size())});
     for (const Rational& g : b.gravity) putRational(h, g);
     putRational(h, b.grassDrag);
-    // Only when set to another value, behind a tag: recordings made before the key existed (at
-    // the default) keep their fingerprint.
+    // The sweeps an island of touching bodies gets (World: at least velocityIterations), behind a
+    // tag, only when they differ from a lone body's: before the key existed every island had
+    // velocityIterations, so a scenario that asks for that keeps its old fingerprint (and its old
+    // bits), and one that does not (the default, 6) is told apart from a recording made then.
+    const int islandSweeps = std::max(b.velocityIterations, b.islandVelocityIterations);
+    if (islandSweeps != b.velocityIterations) putInts(h, {0x69736c616e64, islandSweeps});  // "island"
     if (!(b.contactHertz == Rational{60, 1})) {
       putInts(h, {0x636f6e7461637448});  // "contactH"
       putRational(h, b.contactHertz);

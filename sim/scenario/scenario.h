@@ -195,7 +195,11 @@ struct Scenario {
     /// solve and relax sweeps per sub-step (3 and 1: with Box2D's 1 solve sweep a 20-box stack
     /// falls, docs/physics-notes.md).
     int substeps = 4;
-    int velocityIterations = 3;  ///< solve sweeps per sub-step
+    int velocityIterations = 3;  ///< solve sweeps per sub-step of a body alone (its terrain contacts)
+    /// Solve sweeps per sub-step of an island of touching bodies (at least velocityIterations):
+    /// Gauss-Seidel carries a correction across one contact per sweep, and a heavy or wide load on a
+    /// lighter support rocked for ever at 3 (docs/physics-notes.md).
+    int islandVelocityIterations = 6;
     int positionIterations = 1;  ///< relax sweeps per sub-step (0: the push velocity stays)
     /// Hz: the soft contacts' spring (Box2D's contactHertz), capped at a quarter of the sub-step
     /// rate; the terrain's is twice it. The default is the cap at 60 Hz ticks and 4 sub-steps;

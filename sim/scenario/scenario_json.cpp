@@ -505,8 +505,9 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
 void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
   const std::string p = "$.bodies";
   r.object(j, p,
-           {"gravity", "substeps", "velocityIterations", "positionIterations", "contactHertz", "particleBroadphase",
-            "bodyBroadphase", "boxParticleNormal", "tipContact", "mowerCutHeight", "grassDrag", "list"});
+           {"gravity", "substeps", "velocityIterations", "islandVelocityIterations", "positionIterations",
+            "contactHertz", "particleBroadphase", "bodyBroadphase", "boxParticleNormal", "tipContact", "mowerCutHeight",
+            "grassDrag", "list"});
   if (j.contains("contactHertz")) b.contactHertz = r.positive(j["contactHertz"], p + ".contactHertz");
   if (j.contains("grassDrag")) b.grassDrag = r.nonNegative(j["grassDrag"], p + ".grassDrag");
   if (j.contains("mowerCutHeight")) b.mowerCutHeight = r.nonNegative(j["mowerCutHeight"], p + ".mowerCutHeight");
@@ -514,6 +515,9 @@ void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
   if (j.contains("substeps")) b.substeps = int(r.integer(j["substeps"], p + ".substeps", 1, 64));
   if (j.contains("velocityIterations"))
     b.velocityIterations = int(r.integer(j["velocityIterations"], p + ".velocityIterations", 1, 1000));
+  if (j.contains("islandVelocityIterations"))
+    b.islandVelocityIterations =
+        int(r.integer(j["islandVelocityIterations"], p + ".islandVelocityIterations", 1, 1000));
   if (j.contains("positionIterations"))
     b.positionIterations = int(r.integer(j["positionIterations"], p + ".positionIterations", 0, 1000));
   if (j.contains("particleBroadphase"))

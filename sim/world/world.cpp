@@ -128,6 +128,7 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   // The soft step's sub-step h = dt / substeps and its rate, each rounded once from exact values.
   solver_.substeps = s.bodies.substeps;
   solver_.solveIterations = s.bodies.velocityIterations;
+  solver_.islandSolveIterations = std::max(s.bodies.velocityIterations, s.bodies.islandVelocityIterations);
   solver_.relaxIterations = s.bodies.positionIterations;
   const Rational substep = *div(s.timeStep, Rational{s.bodies.substeps, 1});
   substepDt_ = toS<S>(substep);
