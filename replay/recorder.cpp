@@ -74,6 +74,8 @@ StepResult Recorder::step(const TickInput& input, StageObserver* observer) {
     throw std::runtime_error(
         writer_.path() + ": cannot record more than " + std::to_string(sgr::kMaxTickGap) +
         " ticks without a hash, a snapshot or an input (record with a check or snapshot interval)");
+  // The particle pass takes the row groups' digests as it goes, on its threads (state_hash.h).
+  if (check || snap) world_.requestStateHash();
   StepResult r = world_.step(input, observer);
   if (r.ok) {
     const int64_t t = world_.tick();

@@ -47,10 +47,10 @@ inline Scenario singleTuft(GrassModel mode) {
 
 /// A World<S> for a scenario, validated for S first (tests that need typed access).
 template <class S>
-std::unique_ptr<World<S>> makeTyped(Scenario s) {
+std::unique_ptr<World<S>> makeTyped(Scenario s, int threads = 1) {
   s.scalar = ScalarTraits<S>::kind;
   validateForScalar(s, s.scalar, 0);
-  return std::make_unique<World<S>>(s, 1);
+  return std::make_unique<World<S>>(s, threads);
 }
 
 /// (x, y, z) / den as exact fractions.

@@ -1,4 +1,6 @@
-// The `.sgr` recording format, version 1 (docs/replay-format.md is the normative description).
+// The `.sgr` recording format, version 2 (docs/replay-format.md is the normative description).
+// Version 2 (2026-11-28) has version 1's layout; its CHCK and SNAP hashes are block hashes
+// (sim/state/state_hash.h), and a version 1 file is refused with that reason.
 //
 // A recording is an 8-byte magic and a u32 format version, then a stream of chunks:
 //   u32 type (four ASCII letters) | u32 payload length | payload | u64 XXH3-64 of type, length
@@ -20,7 +22,7 @@
 namespace sg::sgr {
 
 inline constexpr uint8_t kMagic[8] = {0x89, 'S', 'G', 'R', '\r', '\n', 0x1a, '\n'};
-inline constexpr uint32_t kFormatVersion = 1;
+inline constexpr uint32_t kFormatVersion = 2;
 inline constexpr size_t kPreambleBytes = 12;     ///< magic + version
 inline constexpr size_t kChunkHeaderBytes = 8;   ///< type + length
 inline constexpr size_t kChunkTrailerBytes = 8;  ///< checksum

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "sim/state/state_format.h"
+#include "sim/state/state_hash.h"
 #include "sim/state/state_reader.h"
 #include "sim/state/state_sink.h"
 #include "sim/world/world.h"
@@ -36,7 +37,7 @@ void checkFloatValues(state::Cursor at, uint64_t n, const char* what) {
 }  // namespace
 
 template <class S>
-void World<S>::serialise(StateSink& sink) const {
+void World<S>::serialise(StateSink& sink, const uint64_t* groupDigests) const {
   using namespace state;
   syncFromDevice();
   const uint64_t n = uint64_t(grid_.size());
@@ -53,12 +54,24 @@ void World<S>::serialise(StateSink& sink) const {
   sink.put(uint32_t(bodies_.size()));
   sink.put(uint32_t(0));
 
+  // The particle arrays, or for the state hash their row groups' digests (state_hash.h); the
+  // section lengths are the saved ones either way.
+  const size_t groups = size_t(particleGroups());
   putSection(sink, Section::Particles, 6 * n * sizeof(S));
-  for (const auto* v : {&particles_.px, &particles_.py, &particles_.pz, &particles_.vx, &particles_.vy, &particles_.vz})
-    sink.putArray(v->data(), v->size());
+  size_t array = 0;
+  for (const auto* v :
+       {&particles_.px, &particles_.py, &particles_.pz, &particles_.vx, &particles_.vy, &particles_.vz}) {
+    if (groupDigests)
+      sink.putArray(groupDigests + groups * array++, groups);
+    else
+      sink.putArray(v->data(), v->size());
+  }
   if (!particles_.trample.empty()) {
     putSection(sink, Section::Trample, n * sizeof(S));
-    sink.putArray(particles_.trample.data(), n);
+    if (groupDigests)
+      sink.putArray(groupDigests + groups * array, groups);
+    else
+      sink.putArray(particles_.trample.data(), n);
   }
 
   putSection(sink, Section::Bodies, bodies_.size() * (13 * sizeof(S) + kBodyExtraBytes));
@@ -113,9 +126,41 @@ void World<S>::serialise(StateSink& sink) const {
 
 template <class S>
 uint64_t World<S>::stateHash() const {
+  syncFromDevice();
+  // The digests the last step's particle pass took (requestStateHash), or taken now.
+  std::vector<uint64_t> fresh;
+  if (!rowDigestsCurrent_) fresh = particleGroupDigests();
   HashSink h;
-  serialise(h);
+  serialise(h, rowDigestsCurrent_ ? rowDigests_.data() : fresh.data());
   return h.digest();
+}
+
+template <class S>
+int64_t World<S>::particleGroups() const {
+  const int64_t perGroup = stateHashRowsPerGroup(grid_.countX);
+  return (grid_.countZ + perGroup - 1) / perGroup;
+}
+
+template <class S>
+std::vector<uint64_t> World<S>::particleGroupDigests() const {
+  syncFromDevice();
+  std::vector<uint64_t> digests(size_t(particles_.trample.empty() ? 6 : 7) * size_t(particleGroups()));
+  pool_->run(particleGroups(), [&](int64_t g, int) { digestParticleGroup(g, digests.data()); });
+  return digests;
+}
+
+template <class S>
+void World<S>::digestParticleGroup(int64_t group, uint64_t* out) const {
+  const int64_t perGroup = stateHashRowsPerGroup(grid_.countX), width = grid_.countX;
+  const int64_t begin = group * perGroup * width, end = std::min(grid_.countZ, (group + 1) * perGroup) * width;
+  const size_t groups = size_t(particleGroups()), n = size_t(end - begin);
+  out += size_t(group);
+  for (const auto* v :
+       {&particles_.px, &particles_.py, &particles_.pz, &particles_.vx, &particles_.vy, &particles_.vz}) {
+    *out = rowDigest(v->data() + begin, n);
+    out += groups;
+  }
+  if (!particles_.trample.empty()) *out = rowDigest(particles_.trample.data() + begin, n);
 }
 
 template <class S>
@@ -318,6 +363,7 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   tick_ = tick;
   failed_ = false;
   failure_ = SimError{};
+  rowDigestsCurrent_ = false;  // new particles: the state hash takes its digests afresh
   updatePatchState();
 }
 
@@ -375,11 +421,14 @@ void World<S>::exportState(StateExport& out) const {
   for (const auto& [key, value] : cuts_) out.cuts.push_back({key.first, key.second});
 }
 
-#define SG_INSTANTIATE_STATE_IO(S)                                \
-  template void World<S>::serialise(StateSink&) const;            \
-  template uint64_t World<S>::stateHash() const;                  \
-  template std::vector<uint8_t> World<S>::saveState() const;      \
-  template void World<S>::restoreState(std::span<const uint8_t>); \
+#define SG_INSTANTIATE_STATE_IO(S)                                       \
+  template void World<S>::serialise(StateSink&, const uint64_t*) const;  \
+  template uint64_t World<S>::stateHash() const;                         \
+  template int64_t World<S>::particleGroups() const;                     \
+  template std::vector<uint64_t> World<S>::particleGroupDigests() const; \
+  template void World<S>::digestParticleGroup(int64_t, uint64_t*) const; \
+  template std::vector<uint8_t> World<S>::saveState() const;             \
+  template void World<S>::restoreState(std::span<const uint8_t>);        \
   template void World<S>::exportState(StateExport&) const;
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE_STATE_IO)
 

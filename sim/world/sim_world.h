@@ -108,8 +108,13 @@ class SimWorld {
   virtual WorldCounts counts() const = 0;
   /// Advances one tick. After a fault the world stays failed and every later call fails too.
   virtual StepResult step(const TickInput& input, StageObserver* observer = nullptr) = 0;
-  /// xxHash3-64 of the canonical little-endian serialisation (the same bytes as saveState()).
+  /// The state hash (sim/state/state_hash.h): XXH3-64 of the canonical serialisation (the bytes
+  /// of saveState()) with each particle array's row groups replaced by their digests.
   virtual uint64_t stateHash() const = 0;
+  /// Asks the next step to take the particle row groups' digests as it moves them (on its threads, with
+  /// the rows in cache), so that stateHash() after it hashes only the small sections. A recorder
+  /// or a replay calls it before each tick it checks. Changes no state and no hash.
+  virtual void requestStateHash() = 0;
   virtual std::vector<uint8_t> saveState() const = 0;
   /// Throws StateError when the bytes are not a state of this world's scenario and scalar.
   virtual void restoreState(std::span<const uint8_t> bytes) = 0;

@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "sim/scenario/fingerprint.h"
+#include "sim/state/state_hash.h"
 #include "sim/world/settings.h"
 
 namespace sg {
@@ -205,7 +206,9 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   dispX_.assign(size_t(grid_.size()), S(0));
   dispY_.assign(size_t(grid_.size()), S(0));
   dispZ_.assign(size_t(grid_.size()), S(0));
-  rowsPerChunk_ = std::max<int64_t>(1, settings::kTargetChunkElements / grid_.countX);
+  // kTargetChunkElements particles' worth of whole rows, which is also the state hash's row group:
+  // the particle pass takes a group's digests when it has moved the group (state_hash.h).
+  rowsPerChunk_ = stateHashRowsPerGroup(grid_.countX);
   setThreads(pool_->threads());
   takeFixedFaults();
   updatePatchState();

@@ -47,6 +47,7 @@ class World final : public SimWorld {
   WorldCounts counts() const override;
   StepResult step(const TickInput& input, StageObserver* observer = nullptr) override;
   uint64_t stateHash() const override;
+  void requestStateHash() override { digestRowsInNextStep_ = true; }
   std::vector<uint8_t> saveState() const override;
   void restoreState(std::span<const uint8_t> bytes) override;
   void setThreads(int threads) override;
@@ -83,6 +84,7 @@ class World final : public SimWorld {
     syncFromDevice();
     hostAhead_ = true;
     deviceDisplacementCurrent_ = false;
+    rowDigestsCurrent_ = false;
     return particles_;
   }
   const PatchArrays<S>& patches() const {
@@ -160,7 +162,17 @@ class World final : public SimWorld {
   void solveIslands();
   bool bodiesFaulted(Stage stage);
   void mowGrass();
-  void serialise(class StateSink& sink) const;
+  /// The canonical serialisation; with `groupDigests` (particleGroupDigests' layout) each
+  /// particle array's payload is its row groups' digests instead: what stateHash() hashes
+  /// (state_hash.h).
+  void serialise(class StateSink& sink, const uint64_t* groupDigests = nullptr) const;
+  /// Row groups (stateHashRowsPerGroup) of the particle arrays.
+  int64_t particleGroups() const;
+  /// The digests of every particle array's row groups: array-major (px, py, pz, vx, vy, vz, then
+  /// trample when the grass tramples), each array's groups in storage order. On the pool.
+  std::vector<uint64_t> particleGroupDigests() const;
+  /// One group's digests into `out` (particleGroupDigests' layout).
+  void digestParticleGroup(int64_t group, uint64_t* out) const;
   // Level-of-detail window.
   int64_t nearestParticleColumn(S coordinate, S fieldOrigin) const;
   int64_t clampWindowOrigin(int64_t origin, bool alongX) const;
@@ -221,6 +233,13 @@ class World final : public SimWorld {
   std::vector<S> dispX_, dispY_, dispZ_;  ///< per-particle tip displacement (patch-state scratch)
   std::vector<S> rowScratch_;             ///< per-worker interpolation row
   int64_t rowsPerChunk_ = 1;
+  // The state hash's row-group digests (state_hash.h): requested for the next step, taken by its
+  // particle pass, and current until the particles change again (a step, a restore,
+  // mutableParticles).
+  bool digestRowsInNextStep_ = false;
+  bool digestRowsThisStep_ = false;
+  bool rowDigestsCurrent_ = false;
+  std::vector<uint64_t> rowDigests_;
   bool exactRowWeights_ = false;  ///< k = 2 or 4 with exact weights: the patch stage uses constant weights
   int64_t tick_ = 0;
   bool failed_ = false;

@@ -3,6 +3,7 @@
 // a fault is attributed to the stage that raised it.
 #include "sim/bodies/sleep_islands.h"
 #include "sim/particles/blade.h"
+#include "sim/state/state_hash.h"
 #include "sim/world/settings.h"
 #include "sim/world/world.h"
 #include "sim/world/world_rows.h"
@@ -54,6 +55,9 @@ template <class S>
 StepResult World<S>::step(const TickInput& input, StageObserver* observer) {
   if (failed_) return {false, failure_};
   takeFixedFaults();  // faults raised outside the step (tools, tests) are not this tick's
+  digestRowsThisStep_ = digestRowsInNextStep_;
+  digestRowsInNextStep_ = false;
+  rowDigestsCurrent_ = false;  // the particles are about to move
   // One stage: timed through the observer (begin and end always paired); a stage that fails has
   // recorded its fault in failure_ and the tick stops there.
   auto stage = [&](Stage st, auto&& run) {
@@ -143,27 +147,39 @@ bool World<S>::integrateStage() {
   const bool onDevice = device_ && deviceParticlePass();
   const bool rowUniform = windSchedule_.rowUniform();
   const LatticeWindow& window = grid_.window;
-  const bool moved =
-      onDevice || runParticleRows(Stage::Integrate, [&](int64_t row, int64_t b, int64_t e) -> RowFault {
-        const int64_t latticeRow = window.latticeRow(row);
-        if (rowUniform) {  // the wind acts per lattice row
-          const size_t r = size_t(latticeRow);
-          return advance(b, e, rowAccel_.x[r], rowAccel_.y[r], rowAccel_.z[r]);
-        }
-        // Gust fronts crossing the rows: runs of columns under the same wind (sim/wind/wind.h), each
-        // advanced as a row would be, in storage order (a window wraps its columns at most once).
-        thread_local std::vector<WindRun<S>> runs;
-        thread_local std::vector<WindPiece> pieces;
-        computeRowWind(windSchedule_, windConsts_, tick_, latticeRow, window.originI, window.endI(), &runs);
-        windPiecesInStorageOrder(window, grid_.countX, runs, &pieces);
-        for (const WindPiece& piece : pieces) {
-          const WindRun<S>& run = runs[piece.run];
-          const RowFault fault = advance(b + piece.begin, b + piece.end, run.dvx, run.dvy, run.dvz);
-          if (fault.particle >= 0) return fault;
-        }
-        (void)e;
-        return {};
-      });
+  const auto advanceRow = [&](int64_t row, int64_t b, int64_t e) -> RowFault {
+    const int64_t latticeRow = window.latticeRow(row);
+    if (rowUniform) {  // the wind acts per lattice row
+      const size_t r = size_t(latticeRow);
+      return advance(b, e, rowAccel_.x[r], rowAccel_.y[r], rowAccel_.z[r]);
+    }
+    // Gust fronts crossing the rows: runs of columns under the same wind (sim/wind/wind.h), each
+    // advanced as a row would be, in storage order (a window wraps its columns at most once).
+    thread_local std::vector<WindRun<S>> runs;
+    thread_local std::vector<WindPiece> pieces;
+    computeRowWind(windSchedule_, windConsts_, tick_, latticeRow, window.originI, window.endI(), &runs);
+    windPiecesInStorageOrder(window, grid_.countX, runs, &pieces);
+    for (const WindPiece& piece : pieces) {
+      const WindRun<S>& run = runs[piece.run];
+      const RowFault fault = advance(b + piece.begin, b + piece.end, run.dvx, run.dvy, run.dvz);
+      if (fault.particle >= 0) return fault;
+    }
+    (void)e;
+    return {};
+  };
+  // A requested state hash takes each row group's digests right after the group moved: a group is
+  // one chunk of this pass, moved by one thread in row order (state_hash.h).
+  static_assert(settings::kTargetChunkElements == kStateHashGroupElements, "a chunk of the pass is a digest group");
+  const bool digest = digestRowsThisStep_ && !onDevice;
+  const int64_t rowsPerGroup = stateHashRowsPerGroup(grid_.countX);
+  if (digest) rowDigests_.resize(size_t(particles_.trample.empty() ? 6 : 7) * size_t(particleGroups()));
+  const bool moved = onDevice || runParticleRows(Stage::Integrate, [&](int64_t row, int64_t b, int64_t e) -> RowFault {
+                       const RowFault fault = advanceRow(row, b, e);
+                       if (digest && fault.particle < 0 && ((row + 1) % rowsPerGroup == 0 || row + 1 == grid_.countZ))
+                         digestParticleGroup(row / rowsPerGroup, rowDigests_.data());
+                       return fault;
+                     });
+  rowDigestsCurrent_ = digest && moved;
   if (!moved || bodies_.empty()) return moved;
   // The bodies moved in the response stage (the soft step integrates their positions in every
   // sub-step); here they may fall asleep, by islands.

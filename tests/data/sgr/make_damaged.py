@@ -42,7 +42,7 @@ DAMAGED = os.path.join(HERE, "damaged")
 SEEDS = os.path.join(REPO, "tests", "fuzz", "corpus", "sgr_reader")
 
 MAGIC = b"\x89SGR\r\n\x1a\n"
-VERSION = 1
+VERSION = 2
 PREAMBLE = 12
 MAX_PAYLOAD = {b"HEAD": 256 << 20, b"INPT": 1 << 20, b"CHCK": 16, b"SNAP": 1 << 31, b"END ": 8 + 8 + 1 + 4 + 4096}
 NAME = {b"HEAD": "HEAD", b"INPT": "INPT", b"CHCK": "CHCK", b"SNAP": "SNAP", b"END ": "END"}
@@ -219,7 +219,8 @@ def build(data):
     add("magic-wrong.sgr", "magic", flip(data, 2, 5))  # "\x89SgR..."
     add("magic-png.sgr", "magic", b"\x89PNG\r\n\x1a\n" + data[8:])
     add("magic-short.sgr", "magic", b"SGR" + data[3:12])
-    add("version-2.sgr", "version", data[:8] + struct.pack("<I", 2) + data[12:])
+    add("version-1.sgr", "version", data[:8] + struct.pack("<I", 1) + data[12:])
+    add("version-3.sgr", "version", data[:8] + struct.pack("<I", 3) + data[12:])
     add("version-0.sgr", "version", data[:8] + struct.pack("<I", 0) + data[12:])
 
     # Chunk order and extra chunks, all with valid checksums.
