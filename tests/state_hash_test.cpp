@@ -3,6 +3,7 @@
 // afterwards, on any thread count and kernel; and digests that never go stale.
 #include <gtest/gtest.h>
 
+#include <climits>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -31,11 +32,12 @@ void expectTheDocumentedHash(const Scenario& s, const std::string& file) {
 }
 
 // The thesis meadow (1.1 MB of particles, 6 groups of 27 rows, the last of 16), a trampling blade
-// meadow with bodies (TRMP), a moving level-of-detail window (toroidal rows) and the one-ball
-// corpus source, in each scalar; and rows wider than a group.
+// meadow with bodies (TRMP), a moving level-of-detail window (toroidal rows), gust fronts crossing
+// the rows (a row advanced in pieces) at interpolation k = 2, and the one-ball corpus source, in
+// each scalar; and rows wider than a group.
 TEST(StateHash, IsTheDocumentedHashWhetherThePassTookTheDigestsOrNot) {
   for (const char* file : {"scenarios/thesis-meadow.json", "scenarios/blade-bodies.json", "scenarios/lod-crossing.json",
-                           "tests/data/sgr/tiny.json"}) {
+                           "scenarios/wind-fronts.json", "tests/data/sgr/tiny.json"}) {
     const Scenario s = loadScenarioFile(test::sourcePath(file));
     expectTheDocumentedHash<Fx32>(s, file);
     expectTheDocumentedHash<Fx16>(s, file);
@@ -88,6 +90,19 @@ TEST(StateHash, DigestsTakenByThePassNeverGoStale) {
 
   ASSERT_TRUE(w->step(TickInput{}).ok);  // not requested: the pass takes none
   EXPECT_EQ(w->stateHash(), test::documentedStateHash(w->saveState(), sizeof(Fx32), width));
+}
+
+// A pass that faults after a request leaves no digests behind: the hash of the failed world is
+// still the documented hash of its bytes.
+TEST(StateHash, AFaultingPassLeavesNoDigests) {
+  const Scenario s = loadScenarioFile(test::sourcePath("tests/data/sgr/tiny.json"));
+  auto w = test::makeTyped<Fx16>(s, 2);
+  const size_t width = size_t(w->particleGrid().countX);
+  ASSERT_TRUE(w->step(TickInput{}).ok);
+  w->mutableParticles().vy[width + 2] = Fx16::fromRaw(INT32_MAX - 4);  // overflows Q16.16 when integrated
+  w->requestStateHash();
+  ASSERT_FALSE(w->step(TickInput{}).ok);
+  EXPECT_EQ(w->stateHash(), test::documentedStateHash(w->saveState(), sizeof(Fx16), width));
 }
 
 }  // namespace

@@ -74,6 +74,9 @@ int runScenario(const RunOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   StepResult failure;
   for (int64_t t = 0; t < o.ticks; ++t) {
+    // A tick whose hash is printed, and the last (the final hash): the particle pass takes the
+    // digests on its threads (sim/state/state_hash.h).
+    if (t + 1 == o.ticks || (o.hashEvery > 0 && (world->tick() + 1) % o.hashEvery == 0)) world->requestStateHash();
     StepResult r = world->step(scriptedInput(scenario, world->tick()), &clock);
     if (!r.ok) {
       failure = r;

@@ -1,6 +1,7 @@
 // The `.sgr` recording format, version 2 (docs/replay-format.md is the normative description).
-// Version 2 (2026-11-28) has version 1's layout; its CHCK and SNAP hashes are block hashes
-// (sim/state/state_hash.h), and a version 1 file is refused with that reason.
+// Version 2 (2026-11-28) has version 1's layout; its state hashes (HEAD's initial hash, CHCK, SNAP,
+// END) are of row-group digests (sim/state/state_hash.h), and a version 1 file is refused with that
+// reason.
 //
 // A recording is an 8-byte magic and a u32 format version, then a stream of chunks:
 //   u32 type (four ASCII letters) | u32 payload length | payload | u64 XXH3-64 of type, length

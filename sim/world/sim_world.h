@@ -109,11 +109,14 @@ class SimWorld {
   /// Advances one tick. After a fault the world stays failed and every later call fails too.
   virtual StepResult step(const TickInput& input, StageObserver* observer = nullptr) = 0;
   /// The state hash (sim/state/state_hash.h): XXH3-64 of the canonical serialisation (the bytes
-  /// of saveState()) with each particle array's row groups replaced by their digests.
+  /// of saveState()) with each particle array's row groups replaced by their digests. Takes the
+  /// digests on the world's threads when the last step did not: call it from one thread at a time,
+  /// never from inside one of the world's own pool jobs.
   virtual uint64_t stateHash() const = 0;
   /// Asks the next step to take the particle row groups' digests as it moves them (on its threads, with
   /// the rows in cache), so that stateHash() after it hashes only the small sections. A recorder
-  /// or a replay calls it before each tick it checks. Changes no state and no hash.
+  /// or a replay calls it before each tick it checks. Changes no state and no hash. On the device
+  /// path the step takes none (stateHash() takes them after copying the particles back).
   virtual void requestStateHash() = 0;
   virtual std::vector<uint8_t> saveState() const = 0;
   /// Throws StateError when the bytes are not a state of this world's scenario and scalar.

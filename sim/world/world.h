@@ -80,7 +80,9 @@ class World final : public SimWorld {
     syncFromDevice();
     return particles_;
   }
-  ParticleArrays<S>& mutableParticles() {  ///< tests: set up states
+  /// Tests and tools: set up states. The reference is good until the next step (the device copy
+  /// and the state hash's digests are told of a change here, not of later writes through it).
+  ParticleArrays<S>& mutableParticles() {
     syncFromDevice();
     hostAhead_ = true;
     deviceDisplacementCurrent_ = false;

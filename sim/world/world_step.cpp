@@ -168,10 +168,11 @@ bool World<S>::integrateStage() {
     return {};
   };
   // A requested state hash takes each row group's digests right after the group moved: a group is
-  // one chunk of this pass, moved by one thread in row order (state_hash.h).
-  static_assert(settings::kTargetChunkElements == kStateHashGroupElements, "a chunk of the pass is a digest group");
-  const bool digest = digestRowsThisStep_ && !onDevice;
+  // one chunk of this pass, moved by one thread in row order (state_hash.h). Should the chunks ever
+  // differ from the groups, the digests are left to stateHash() instead (a group split between two
+  // threads would be hashed while the other still moves it).
   const int64_t rowsPerGroup = stateHashRowsPerGroup(grid_.countX);
+  const bool digest = digestRowsThisStep_ && !onDevice && rowsPerChunk_ == rowsPerGroup;
   if (digest) rowDigests_.resize(size_t(particles_.trample.empty() ? 6 : 7) * size_t(particleGroups()));
   const bool moved = onDevice || runParticleRows(Stage::Integrate, [&](int64_t row, int64_t b, int64_t e) -> RowFault {
                        const RowFault fault = advanceRow(row, b, e);

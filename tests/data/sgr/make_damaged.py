@@ -122,6 +122,8 @@ def predict(data):
             return error(0, "the .sgr magic")
         return error(len(data), "the 12-byte .sgr preamble (the file ends early)")
     version = struct.unpack_from("<I", data, 8)[0]
+    if version == 1:  # the same layout, the hashes of another definition
+        return error(8, f"format version {VERSION}, got 1 (recorded before 2026-11-28")
     if version != VERSION:
         return error(8, f"format version {VERSION}, got {version}")
     at, have_head, ended, cut = PREAMBLE, False, False, None
