@@ -289,11 +289,11 @@ void checkPreamble(std::span<const uint8_t> all, uint64_t fileSize, const std::s
     throw RecordingError(file, fileSize, "the 12-byte .sgr preamble (the file ends early)");
   }
   const uint32_t version = loadLE<uint32_t>(all.data() + 8);
-  if (version == 1)  // the same layout; its hashes are one XXH3 stream over a state, not blocks
+  if (version == 1)  // the same layout; its hashes are one XXH3 stream over a state (state_hash.h)
     throw RecordingError(file, 8,
                          "format version " + std::to_string(kFormatVersion) +
-                             ", got 1 (recorded before 2026-11-28, when state hashes became block hashes: "
-                             "record it again with this build)");
+                             ", got 1 (recorded before 2026-11-28, when state hashes became hashes of row-group "
+                             "digests: record it again with this build)");
   if (version != kFormatVersion)
     throw RecordingError(file, 8,
                          "format version " + std::to_string(kFormatVersion) + ", got " + std::to_string(version));

@@ -11,10 +11,11 @@
 //
 // Why groups of rows: one XXH3 stream over the whole state ran on one thread after the tick, with
 // the state gone cold in the cache, while the other threads waited: +21 % of a two-thread tick
-// when a recording checks every tick (docs/performance.md, "Recording, seeking, snapshots"). A
-// group is exactly one chunk of the particle pass (kTargetChunkElements), so the pass takes its
-// digests right after it moved the chunk, on whichever thread moved it, with the rows in that
-// core's cache (World::requestStateHash). A digest depends on its rows' values alone, so the hash
+// when a recording checks every tick (about +30 % measured side by side; docs/performance.md,
+// "Recording, seeking, snapshots"). A group is exactly one chunk of the particle pass
+// (World::rowsPerChunk_ is stateHashRowsPerGroup), so the pass takes its digests right after it
+// moved the chunk, on whichever thread moved it, with the rows in that core's cache
+// (World::requestStateHash). A digest depends on its rows' values alone, so the hash
 // is the same for any thread count and machine; it is also what a world computes afresh (after a
 // restore, for a final hash) when no pass took the digests. Whole groups rather than single rows:
 // a digest per row cost 55 instructions of set-up each (906 a tick on the thesis meadow), which

@@ -206,8 +206,9 @@ World<S>::World(const Scenario& s, int threads) : pool_(std::make_unique<ChunkPo
   dispX_.assign(size_t(grid_.size()), S(0));
   dispY_.assign(size_t(grid_.size()), S(0));
   dispZ_.assign(size_t(grid_.size()), S(0));
-  // kTargetChunkElements particles' worth of whole rows, which is also the state hash's row group:
-  // the particle pass takes a group's digests when it has moved the group (state_hash.h).
+  // kStateHashGroupElements (4096, as settings::kTargetChunkElements) particles' worth of whole rows:
+  // a chunk is the state hash's row group, whose digests the particle pass takes when it has moved
+  // the chunk (state_hash.h).
   rowsPerChunk_ = stateHashRowsPerGroup(grid_.countX);
   setThreads(pool_->threads());
   takeFixedFaults();
