@@ -134,7 +134,8 @@ TEST(HeightmapPng, EightBitGrayDecodesToItsExactSamples) {
 // Decision: Adam7 files are accepted. They are valid 8-bit grayscale heightmaps (some tools write
 // them), spng de-interlaces them exactly, and the samples are the same as the plain file's.
 TEST(HeightmapPng, InterlacedDecodesToTheSameSamplesAsThePlainFile) {
-  for (const auto& [w, h] : {std::pair{2u, 2u}, {9u, 5u}, {16u, 16u}, {3u, 11u}}) {
+  // 300x70: the filtered bytes (over 21,000) are more than the stream check's 16 KiB output buffer.
+  for (const auto& [w, h] : {std::pair{2u, 2u}, {9u, 5u}, {16u, 16u}, {3u, 11u}, {33u, 2u}, {2u, 33u}, {300u, 70u}}) {
     Heightmap plain, adam7;
     std::string error;
     ASSERT_TRUE(decodeHeightmapPng(gray8(w, h).bytes(), &plain, &error)) << error;
@@ -222,6 +223,63 @@ TEST(HeightmapPng, APaletteInAGrayImageOrBytesAfterIendAreRefused) {
   Heightmap h;
   std::string error;
   EXPECT_TRUE(decodeHeightmapPng(gray8(4, 3).bytes(), &h, &error)) << error;
+}
+
+/// A PNG whose image data is the given IDAT chunks, in order (then IEND).
+Bytes withIdats(const Png& p, const std::vector<Bytes>& idats) {
+  Png head = p;
+  head.iend = false;
+  Bytes png = head.build(idats.front());
+  for (size_t i = 1; i < idats.size(); ++i) chunk(png, "IDAT", idats[i]);
+  chunk(png, "IEND", {});
+  return png;
+}
+
+// spng stops inflating once the image is whole, so these passed before the core inflated the
+// stream to its end itself (docs/robustness.md): each was accepted, and decoded to the image.
+TEST(HeightmapPng, AStreamCutInsideItsAdler32OrFollowedByMoreDataIsRefused) {
+  const Png p = gray8(6, 5);
+  const Bytes z = deflate(p.raw);
+  // The Adler-32 missing, or cut after 2 of its 4 bytes: a file truncated inside its checksum.
+  expectRefused(p.build(Bytes(z.begin(), z.end() - 4)), "image data whose zlib stream ends with its Adler-32");
+  expectRefused(p.build(Bytes(z.begin(), z.end() - 2)), "image data whose zlib stream ends with its Adler-32");
+  // Bytes after the stream's end, in the same IDAT and in another one.
+  Bytes tail = z;
+  tail.insert(tail.end(), {1, 2, 3});
+  const size_t streamEnd = idatOffset(p.bytes()) + 8 + z.size();
+  expectRefused(p.build(tail), "nothing after the end of the image's zlib stream (3 more bytes at byte " +
+                                   std::to_string(streamEnd) + ")");
+  expectRefused(withIdats(p, {z, Bytes{0x78}}), "nothing after the end of the image's zlib stream (1 more IDAT bytes");
+  // A second whole stream glued behind the first.
+  expectRefused(withIdats(p, {z, z}), "nothing after the end of the image's zlib stream");
+  // A stream holding more than the image: one scanline too many, with its Adler-32 right.
+  Bytes longer = p.raw;
+  longer.insert(longer.end(), 7, 0);
+  expectRefused(p.build(deflate(longer)), "image data that inflates to exactly 35 bytes (the zlib stream holds more");
+  // The same for an interlaced file (its seven passes' filter bytes counted).
+  const Png adam7 = gray8Interlaced(9, 5);
+  const Bytes za = deflate(adam7.raw);
+  expectRefused(adam7.build(Bytes(za.begin(), za.end() - 4)), "image data whose zlib stream ends with its Adler-32");
+}
+
+TEST(HeightmapPng, AStreamSplitOverManyIdatChunksStillDecodes) {
+  // Valid PNGs: IDAT chunks of one byte each, empty ones between, and an image whose filtered
+  // bytes fill the stream check's output buffer more than once.
+  for (const Png& p : {gray8(6, 5), gray8(300, 70)}) {
+    const Bytes z = deflate(p.raw);
+    std::vector<Bytes> bytewise;
+    for (uint8_t b : z) {
+      bytewise.push_back(Bytes{b});
+      bytewise.push_back(Bytes{});
+    }
+    for (const Bytes& png : {p.bytes(), withIdats(p, bytewise), withIdats(p, {z, Bytes{}})}) {
+      Heightmap hm;
+      std::string error;
+      ASSERT_TRUE(decodeHeightmapPng(png, &hm, &error)) << p.width << "x" << p.height << ": " << error;
+      EXPECT_EQ(hm.samples.size(), size_t(p.width) * p.height);
+      EXPECT_EQ(hm.samples.back(), sampleAt(p.width - 1, p.height - 1));
+    }
+  }
 }
 
 TEST(HeightmapPng, OtherDepthsAndColourTypesAreRefusedBeforeDecoding) {
