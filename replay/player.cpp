@@ -78,7 +78,7 @@ Player::Player(const sgr::Recording& recording, int threads, const VariantSettin
   }
   largestStateBytes_ = largestState(world_->counts());
   // Spawn commands add bodies up to kMaxBodies: commands may name those indices too.
-  const int64_t bodies = std::max<int64_t>(world_->counts().bodies, kMaxBodies);
+  const int64_t bodies = bodyIndexLimit(size_t(world_->counts().bodies));
   for (const sgr::InputRecord& in : recording.inputs)
     for (const BodyCommand& c : in.input.bodies)
       if (c.body >= bodies)

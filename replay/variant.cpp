@@ -16,6 +16,15 @@ const char* bodyBroadphaseName(BodyBroadphase b) { return b == BodyBroadphase::S
 
 VariantSettings VariantSettings::parse(const std::string& text) {
   VariantSettings v;
+  // "interp=2," or "interp=2,,scalar=fx16" ran as "interp=2" (commas became spaces): an empty
+  // item between commas is a typo, as `render --debug 'particles,'` already says.
+  {
+    std::string item;
+    std::istringstream items(text + ",");
+    while (std::getline(items, item, ','))
+      if (item.find_first_not_of(" \t") == std::string::npos)
+        bad("'" + text + "'", "KEY=VALUE items separated by single commas (an empty item)");
+  }
   std::string spaced = text;
   for (char& ch : spaced)
     if (ch == ',') ch = ' ';

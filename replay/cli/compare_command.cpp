@@ -311,7 +311,7 @@ void addCompareCommand(CLI::App& app, int* exitCode) {
       ->allow_extra_args(false)  // one value per --variant: `--variant interp=2 run.sgr` keeps run.sgr
       ->check(nonEmptyValue("KEY=VALUE", "KEY=VALUE"));
   cmd->add_option("--ticks", o->ticks, "Compare the first N ticks (default: the whole recording)")
-      ->check(CLI::Range(int64_t(1), int64_t(1) << 40));
+      ->check(CLI::Range(int64_t(1), kMaxTick));
   cmd->add_option("--threads", o->threads, "Worker threads of the reference and of variants without threads=")
       ->check(CLI::Range(1, 256));
   cmd->add_option("--csv", o->csv, "Write one row per variant (the reference first) to this CSV file");

@@ -13,6 +13,7 @@
 #include "replay/cli/compare_command.h"
 #include "replay/cli/diff_command.h"
 #include "replay/cli/gpu_hook.h"
+#include "replay/cli/option_checks.h"
 #include "replay/cli/record_command.h"
 #include "replay/cli/render_hook.h"
 #include "replay/cli/replay_command.h"
@@ -75,6 +76,7 @@ int main(int argc, char** argv) {
   sg::addSweepCommand(app, &exitCode);
   sg::addRenderCommand(app, &exitCode);  // the viewer's, or a stub in a build without it
   makeIntegerOptionsDecimal(app);
+  sg::refuseEmptyValues(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -210,7 +210,7 @@ void addRecordCommand(CLI::App& app, int* exitCode) {
   cmd->add_option("scenario", o->scenario, "Scenario JSON file (default: the built-in thesis meadow)");
   cmd->add_option("-o,--output", o->output, "Recording to write (.sgr)")->required();
   cmd->add_option("--ticks", o->ticks, "Ticks to record (default: the input track's 'ticks', else 600)")
-      ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
+      ->check(CLI::Range(int64_t(0), kMaxTick));
   cmd->add_option("--input", o->inputTrack,
                   "Input-track JSON (camera keys and body commands) instead of the scenario's script");
   cmd->add_option("--variant", o->variants,

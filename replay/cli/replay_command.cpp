@@ -232,7 +232,7 @@ void addReplayCommand(CLI::App& app, int* exitCode) {
   cmd->add_option("recording", o->file, "Recording (.sgr)")->required();
   cmd->add_flag("--verify", o->verify, "Recompute every recorded hash; report the first tick that differs (exit 1)");
   cmd->add_option("--to", o->to, "Seek to this tick through the nearest snapshot")
-      ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
+      ->check(CLI::Range(int64_t(0), kMaxTick));
   cmd->add_option("--export-state", o->exportState,
                   "Write the state reached to this file: NAME.json the documented JSON form, any other name the binary "
                   "state (docs/state-format.md)");

@@ -192,8 +192,7 @@ void addRunCommand(CLI::App& app, int* exitCode) {
   CLI::App* run =
       app.add_subcommand("run", "Run a scenario headless and print the final state hash, timings and counts");
   run->add_option("scenario", opts->scenario, "Scenario JSON file (default: the built-in thesis meadow)");
-  run->add_option("--ticks", opts->ticks, "Number of fixed ticks to run")
-      ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
+  run->add_option("--ticks", opts->ticks, "Number of fixed ticks to run")->check(CLI::Range(int64_t(0), kMaxTick));
   run->add_option("--scalar", opts->scalar, "Scalar type, overriding the scenario")
       ->check(CLI::IsMember({"fx32", "fx16", "float", "double"}));
   run->add_option("--interp", opts->interp, "Interpolation k (1 = one particle per patch, 2 = per 2x2, ...)")
@@ -201,7 +200,7 @@ void addRunCommand(CLI::App& app, int* exitCode) {
   run->add_option("--threads", opts->threads, "Worker threads (the result is identical for any count)")
       ->check(CLI::Range(1, 256));
   run->add_option("--hash-every", opts->hashEvery, "Also print the state hash every N ticks")
-      ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
+      ->check(CLI::Range(int64_t(0), kMaxTick));
   run->add_option("--broadphase", opts->broadphase, "Particle-vs-body broad phase (the state is identical)")
       ->check(CLI::IsMember({"grid", "brute"}));
   run->add_option("--body-broadphase", opts->bodyBroadphase, "Body-vs-body broad phase (the state is identical)")

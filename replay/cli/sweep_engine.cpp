@@ -30,6 +30,10 @@ std::vector<T> parseList(const char* option, const std::string& text, const char
   for (const std::string& item : splitList(text)) {
     std::optional<T> v = parse(item);
     if (!v) throw std::invalid_argument(std::string(option) + ": expected " + expected + ", got '" + item + "'");
+    // `--k 1,1` swept the same variant twice (and fed both to the Pareto plots): each value once,
+    // compared as values (1/60 and 2/120 are one time step).
+    if (std::find(values.begin(), values.end(), *v) != values.end())
+      throw std::invalid_argument(std::string(option) + ": expected each value once, got '" + item + "' twice");
     values.push_back(*v);
   }
   if (values.empty()) throw std::invalid_argument(std::string(option) + ": expected " + expected + ", got nothing");
@@ -219,7 +223,12 @@ Plan makePlan(const Options& o, bool measureTufts, const char* missingFileHint) 
   // reference settings): the sweep measures each model's discretisation error, not how far two
   // models differ (that is `simgrass compare --variant model=...`).
   std::map<std::string, std::vector<std::array<double, 3>>> tipsCache;  ///< by file and dt
-  for (const std::string& file : splitList(o.scenarios))
+  const std::vector<std::string> files = splitList(o.scenarios);
+  for (size_t i = 0; i < files.size(); ++i)
+    if (!files[i].empty() &&
+        std::find(files.begin(), files.begin() + ptrdiff_t(i), files[i]) != files.begin() + ptrdiff_t(i))
+      throw ScenarioError("--scenarios", "$", "each scenario file once, got '" + files[i] + "' twice");
+  for (const std::string& file : files)
     for (const std::optional<GrassModel>& model : plan.axes.models) {
       ScenarioRun sc;
       sc.file = file;

@@ -142,17 +142,22 @@ bool World<S>::bodiesFaulted(Stage stage) {
       return T::isFinite(v) && !(std::fabs(double(v)) > T::maxStateMagnitude);
     }
   };
-  for (size_t i = 0; i < bodies_.size(); ++i) {
+  // A body is named only when its own values are out of range (float, double); fixed-point
+  // faults say that something overflowed on some thread, not in which body.
+  int32_t outOfRange = -1;
+  for (size_t i = 0; i < bodies_.size() && outOfRange < 0; ++i) {
     const RigidBody<S>& b = bodies_[i];
     bool ok = true;
     for (int k = 0; k < 3; ++k)
       ok = ok && inRange(b.position[k]) && inRange(b.velocity[k]) && inRange(b.angularVelocity[k]);
-    if (faults == 0 && ok) continue;
+    if (!ok) outOfRange = int32_t(i);
+  }
+  if (faults != 0 || outOfRange >= 0) {
     failed_ = true;
     failure_ = SimError{};
     failure_.tick = tick_;
     failure_.stage = stage;
-    failure_.body = int32_t(i);
+    failure_.body = outOfRange >= 0 ? outOfRange : kSomeBody;
     failure_.what =
         faults ? fixedFaultName(faults) : "a value that is not finite or beyond +-2^48 (a saved state's range)";
     return true;

@@ -93,8 +93,19 @@ enum class BodyCommandKind : uint8_t {
   DragTo,       ///< a spring (settings::kDragHertz) pulls the centre of mass toward value (m) for
                 ///< this tick: the viewer's mouse drag, one command a tick while the button is held
 };
-/// Scenario bodies plus spawned ones never exceed this; a Spawn beyond it is ignored.
+/// A Spawn while the world holds this many bodies or more is ignored (a scenario may list up to
+/// 1,024 bodies; then nothing spawns, and commands may name every listed one: bodyIndexLimit).
 inline constexpr int kMaxBodies = 64;
+/// The largest tick anything may name or run to: ticks are below 2^40 (a script command's or
+/// camera key's tick, an input track's length, a command line's --ticks, --to, --hash-every).
+/// 2^40 ticks at 1/60 s are 580 years; the bound keeps tick arithmetic far from int64 overflow.
+inline constexpr int64_t kMaxTick = (int64_t(1) << 40) - 1;
+/// Body indices a world of `listedBodies` can hold: 0 .. max(listed, kMaxBodies) - 1 (a list
+/// longer than the spawn limit leaves no room to spawn, but its own bodies are all addressable).
+/// What a script, an input track and a recording's INPT may name, and what a state may hold.
+inline int64_t bodyIndexLimit(size_t listedBodies) {
+  return listedBodies > size_t(kMaxBodies) ? int64_t(listedBodies) : int64_t(kMaxBodies);
+}
 /// A camera key of a camera track: the camera sits at `position` from `tick` until the next key.
 struct CameraKey {
   int64_t tick = 0;

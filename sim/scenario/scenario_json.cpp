@@ -502,7 +502,7 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
   return b;
 }
 
-void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
+void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b, GrassModel writtenModel) {
   const std::string p = "$.bodies";
   r.object(j, p,
            {"gravity", "substeps", "velocityIterations", "islandVelocityIterations", "positionIterations",
@@ -532,9 +532,16 @@ void parseBodies(const Reader& r, const json& j, Scenario::Bodies& b) {
     b.boxParticleNormal =
         r.choice<BoxParticleNormal>(j["boxParticleNormal"], p + ".boxParticleNormal",
                                     {{"up", BoxParticleNormal::Up}, {"nearest-face", BoxParticleNormal::NearestFace}});
-  if (j.contains("tipContact"))
+  if (j.contains("tipContact")) {
     b.tipContact = r.choice<TipContact>(j["tipContact"], p + ".tipContact",
                                         {{"push", TipContact::Push}, {"hold", TipContact::Hold}});
+    // The blade always holds: a file that asks it to push would run exactly as "hold" (an
+    // independent pass found the key ignored). A `--variant model=blade` over a thesis file with
+    // "push" is a comparison across models, and the blade's docs say it holds.
+    if (writtenModel == GrassModel::Blade && b.tipContact == TipContact::Push)
+      r.failGot(p + ".tipContact", "\"hold\" or no tipContact with \"model\": \"blade\" (a blade always holds)",
+                j["tipContact"]);
+  }
   if (j.contains("list")) {
     const json& l = j["list"];
     if (!l.is_array() || l.size() > 1024) r.failGot(p + ".list", "an array of at most 1024 bodies", l);
@@ -568,7 +575,7 @@ void parseCamera(const Reader& r, const json& cams, const std::string& p, std::v
     if (!cams[i].contains("tick")) r.fail(q + ".tick", "the tick the camera moves (missing)");
     if (!cams[i].contains("position")) r.fail(q + ".position", "a position [x, y, z] (missing)");
     CameraKey key;
-    key.tick = r.integer(cams[i]["tick"], q + ".tick", 0, int64_t(1) << 40);
+    key.tick = r.integer(cams[i]["tick"], q + ".tick", 0, kMaxTick);
     if (!out.empty() && key.tick <= out.back().tick)
       r.failGot(q + ".tick", "a tick after the previous camera key's " + std::to_string(out.back().tick),
                 cams[i]["tick"]);
@@ -597,8 +604,9 @@ void parseLod(const Reader& r, const json& j, Scenario::Lod& l) {
 /// A command's body: a name from $.bodies.list, or an index (scenario bodies first, then spawned
 /// ones in spawn order; a command to an index that does not exist when it runs is ignored).
 int32_t scriptBody(const Reader& r, const json& body, const Scenario& s, const std::string& p) {
-  if (body.is_number_integer()) return int32_t(r.integer(body, p, 0, kMaxBodies - 1));
-  if (!body.is_string()) r.failGot(p, "a body name or index 0.." + std::to_string(kMaxBodies - 1), body);
+  const int64_t last = bodyIndexLimit(s.bodies.list.size()) - 1;
+  if (body.is_number_integer()) return int32_t(r.integer(body, p, 0, last));
+  if (!body.is_string()) r.failGot(p, "a body name or index 0.." + std::to_string(last), body);
   const std::string name = r.string(body, p);
   for (size_t k = 0; k < s.bodies.list.size(); ++k)
     if (s.bodies.list[k].name == name) return int32_t(k);
@@ -616,7 +624,7 @@ void parseScript(const Reader& r, const json& j, const Scenario& s, const std::s
     ScriptedCommand cmd;
     cmd.source = int64_t(i);
     if (!c.contains("tick")) r.fail(q + ".tick", "the tick the command applies to (missing)");
-    cmd.tick = r.integer(c["tick"], q + ".tick", 0, int64_t(1) << 40);
+    cmd.tick = r.integer(c["tick"], q + ".tick", 0, kMaxTick);
     if (!c.contains("body")) r.fail(q + ".body", "a body name or index (missing)");
     cmd.body = scriptBody(r, c["body"], s, q + ".body");
     if (!c.contains("command")) r.fail(q + ".command", "a command (missing)");
@@ -735,7 +743,7 @@ Scenario parseScenario(const std::string& text, const std::string& sourceName, c
   if (root.contains("particles")) parseParticles(r, root["particles"], s.particles);
   if (root.contains("wind")) parseWind(r, root["wind"], s.wind);
   if (root.contains("terrain")) parseTerrain(r, root["terrain"], s.terrain, readFile);
-  if (root.contains("bodies")) parseBodies(r, root["bodies"], s.bodies);
+  if (root.contains("bodies")) parseBodies(r, root["bodies"], s.bodies, s.particles.writtenModel);
   if (root.contains("script")) parseScript(r, root["script"], s, "$.script", s.script);
   if (root.contains("markings")) parseMarkings(r, root["markings"], s.markings);
   if (root.contains("camera")) parseCamera(r, root["camera"], "$.camera", s.camera);
@@ -798,7 +806,7 @@ InputTrack parseInputTrack(const std::string& text, const std::string& sourceNam
   r.object(root, "$", {"format", "ticks", "camera", "commands"});
   if (!root.contains("format") || root["format"] != "simgrass-input-track/1")
     r.failGot("$.format", "\"simgrass-input-track/1\"", root.contains("format") ? root["format"] : json());
-  if (root.contains("ticks")) track.ticks = r.integer(root["ticks"], "$.ticks", 0, (int64_t(1) << 40) - 1);
+  if (root.contains("ticks")) track.ticks = r.integer(root["ticks"], "$.ticks", 0, kMaxTick);
   if (root.contains("camera")) parseCamera(r, root["camera"], "$.camera", track.camera);
   if (root.contains("commands")) parseScript(r, root["commands"], scenario, "$.commands", track.commands);
   validateInputTrack(track, scenario.scalar);

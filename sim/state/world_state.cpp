@@ -194,7 +194,7 @@ void World<S>::restoreState(std::span<const uint8_t> bytes) {
   const uint64_t bodiesAt = head.offset();
   const uint32_t bodyCount = head.read<uint32_t>("the body count");
   // Spawns add bodies up to kMaxBodies (only to worlds that have a template body).
-  const size_t maxBodies = scenarioBodies == 0 ? 0 : std::max(scenarioBodies, size_t(kMaxBodies));
+  const size_t maxBodies = scenarioBodies == 0 ? 0 : size_t(bodyIndexLimit(scenarioBodies));
   if (bodyCount < scenarioBodies || bodyCount > maxBodies)
     throw StateError(
         bodiesAt, (maxBodies == scenarioBodies ? std::to_string(scenarioBodies)

@@ -25,7 +25,7 @@ struct SimError {
   int64_t tick = -1;
   Stage stage = Stage::Count;
   int64_t particle = -1;               ///< particle index, -1 if not particle-specific
-  int32_t body = -1;                   ///< body index, -1 if not body-specific
+  int32_t body = -1;                   ///< body index, -1 if not body-specific, kSomeBody if unknown
   int64_t latticeI = 0, latticeJ = 0;  ///< patch coordinates of that particle
   std::string what;                    ///< "fixed-point overflow", "non-finite value", ...
   std::string message() const;

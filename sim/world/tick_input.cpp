@@ -32,7 +32,7 @@ void setCamera(const std::vector<CameraKey>& keys, int64_t tick, TickInput& inpu
 }  // namespace
 
 std::string describeInputCause(const Scenario& scenario, const InputTrack* track, int64_t tick, int32_t body) {
-  if (body < 0) return "";
+  if (body < 0 && body != kSomeBody) return "";
   static constexpr const char* kCommandNames[] = {"displace", "addVelocity", "impulse",  "teleport", "reset",
                                                   "spawn",    "mowerOn",     "mowerOff", "dragTo"};
   const std::vector<ScriptedCommand>& commands = track ? track->commands : scenario.script;
@@ -59,9 +59,9 @@ std::string describeInputCause(const Scenario& scenario, const InputTrack* track
                kCommandNames[size_t(it->kind)] + " to body " + std::to_string(it->body) + " at tick " +
                std::to_string(it->tick) + ")";
     }
-  } else if (scenario.bodies.list.size() == 1 && body == 0) {
+  } else if (scenario.bodies.list.size() == 1 && (body == 0 || body == kSomeBody)) {
     where = "no input before it; the body as given in " + scenario.sourceName + ": $.bodies.list[0]";
-  } else if (size_t(body) < scenario.bodies.list.size()) {
+  } else if (body == kSomeBody ? !scenario.bodies.list.empty() : size_t(body) < scenario.bodies.list.size()) {
     // Not [body]: the fault bits do not say which of the bodies overflowed.
     where = "no input before it; the bodies as given in " + scenario.sourceName + ": $.bodies.list";
   } else {

@@ -45,13 +45,18 @@ TickInput trackInput(const InputTrack& track, int64_t tick);
 /// Q32.32 raw of an exact value (saturating; scenario validation keeps values in range).
 int64_t toInputRaw(const Rational& value);
 
+/// SimError::body of a fault the body stages raised without knowing which body: fixed-point fault
+/// bits are per thread, not per body (an independent pass saw "body 0" named for body 1's overflow).
+inline constexpr int32_t kSomeBody = -2;
+
 /// Which input a simulation fault of `body` at `tick` most likely came from, for the one-line
 /// error: the commands of the latest tick at or before it (at most four), by file and JSON path
 /// ("last input: track.json: $.commands[4] (teleport to body 2 at tick 50)"),
 /// else the scenario's bodies ("no input before it; the bodies as given in scene.json:
 /// $.bodies.list", or $.bodies.list[0] when there is one body). Commands
-/// come from `track` when given, else the scenario's script. Empty when body < 0 (a particle
-/// fault: the scenario as a whole). Control characters in the file name are escaped.
+/// come from `track` when given, else the scenario's script. Empty when body is -1 (a particle
+/// fault: the scenario as a whole); kSomeBody is a body fault whose body is not known. Control
+/// characters in the file name are escaped.
 std::string describeInputCause(const Scenario& scenario, const InputTrack* track, int64_t tick, int32_t body);
 
 }  // namespace sg

@@ -1,5 +1,6 @@
 #include "viewer/app/options.h"
 
+#include "replay/cli/option_checks.h"
 #include "viewer/app/text.h"
 
 #include <CLI/CLI.hpp>
@@ -52,6 +53,7 @@ int parseOptions(int argc, char** argv, Options* o) {
                  "$XDG_CONFIG_HOME/simgrass or ~/.config/simgrass, none for --script runs");
   app.add_flag("--keys", o->keys, "Print every key and mouse control (the F1 help) and exit");
   app.footer("Exit codes: 0 ok, 1 no window / OpenGL, simulation fault or I/O error, 2 bad input.");
+  sg::refuseEmptyValues(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
