@@ -613,6 +613,51 @@ TEST(BodyAccuracy, FrictionAngleBoundaryOnAHeightmapDouble) { expectFrictionAngl
 
 namespace sg {
 namespace {
+// A ball on a gentle slope rolls (issue 15, "sleep never freezes a body whose contact forces cannot
+// hold it"): one contact point with friction turns the ball about its centre, so no contact
+// force holds it, however far the friction is from its limit. At 0.5 degrees it rolls at
+// 5/7 g sin(theta) = 0.061 m/s^2, 3 cm/s after the half second the speed test waits: it fell
+// asleep there, 7.7 mm from where it started (an independent pass, 2026-11-28). On level ground it
+// still sleeps: gravity has no tangential part, the friction is exactly 0.
+template <class S>
+void expectBallOnAGentleSlopeRolls(const char* name) {
+  for (const double degrees : {0.5, 0.15, 0.0}) {
+    const double theta = degrees * std::numbers::pi / 180;
+    Scenario s = test::emptyWorld();
+    s.bodies.gravity = q12(kG * std::sin(theta), -kG * std::cos(theta), 0);
+    BodySpec ball = test::sphere("ball", Rational{1, 4}, q12(0, 0.25, 0));
+    ball.mass = Rational{1, 1};
+    ball.restitution = Rational{0, 1};
+    ball.friction = Rational{1, 2};
+    s.bodies.list = {ball};
+    auto w = makeTyped<S>(s);
+    const double seconds = 6;
+    run(*w, s, std::llround(seconds / kDt));
+    const auto& b = w->bodies()[0];
+    const double rolled = d(b.position.x());
+    // Rolling without slipping: a = 5/7 g sin(theta) (a solid sphere, I = 2/5 m r^2). Within
+    // 3 %: the first tick's cold start slips a little before friction takes hold, and the speed
+    // of a sub-step's gravity is rounded in fixed point.
+    const double expected = 0.5 * (5.0 / 7.0) * kG * std::sin(theta) * seconds * seconds;
+    if (degrees > 0) {
+      EXPECT_FALSE(b.asleep) << name << " " << degrees << " deg";
+      EXPECT_NEAR(rolled, expected, 0.03 * expected) << name << " " << degrees << " deg";
+    } else {
+      EXPECT_TRUE(b.asleep) << name << " on level ground";
+      EXPECT_NEAR(rolled, 0.0, 1e-6) << name << " on level ground";
+    }
+  }
+}
+TEST(BodyAccuracy, BallOnAGentleSlopeRollsAndOnLevelGroundSleepsFx32) { expectBallOnAGentleSlopeRolls<Fx32>("fx32"); }
+TEST(BodyAccuracy, BallOnAGentleSlopeRollsAndOnLevelGroundSleepsFx16) { expectBallOnAGentleSlopeRolls<Fx16>("fx16"); }
+TEST(BodyAccuracy, BallOnAGentleSlopeRollsAndOnLevelGroundSleepsDouble) {
+  expectBallOnAGentleSlopeRolls<double>("double");
+}
+}  // namespace
+}  // namespace sg
+
+namespace sg {
+namespace {
 // Removing a support wakes what rested on it (issue 15): a box asleep on another box stayed
 // asleep in mid-air when the lower one was teleported away, displaced or reset.
 template <class S>

@@ -47,9 +47,11 @@ Scenario pile() { return loadScenarioFile(test::sourcePath("tests/data/solver_pi
 
 // Steps `s` (scalar S, its script included) on one thread and on each of `threads`, comparing every
 // tick's hash; at each checkpoint (tick, hash; ascending) the one-thread state must be the pinned
-// one, the state the solver gave before it had islands (one sweep over all rows: the final hash
-// of `simgrass run FILE --ticks N --scalar fx32|fx16` built at ec60f04, XXH3-64 of the saved
-// bytes). Stops after the last checkpoint.
+// one. First pinned as the state the solver gave before it had islands (one sweep over all rows,
+// built at ec60f04; the piles ask for 3 sweeps, so the island's 6 left them alone); re-pinned where
+// the physics changed on purpose, from the one-thread run whose thread-count checks passed:
+// 2026-11-28, a slipping contact's friction turned opposite the slip and a body rolling on one
+// point kept awake. XXH3-64 of the saved bytes. Stops after the last checkpoint.
 template <class S>
 void expectThreadsGiveTheSequencesBits(Scenario s, std::vector<int> threads,
                                        std::vector<std::pair<int, uint64_t>> checkpoints, const char* what) {
@@ -78,10 +80,10 @@ void expectThreadsGiveTheSequencesBits(Scenario s, std::vector<int> threads,
 
 // tests/data/solver_pile.json on 1, 2 and 3 threads (2 and 3 solve its islands on the pool).
 TEST(SolverIslands, ThreadsGiveTheSequencesBitsFx32) {
-  expectThreadsGiveTheSequencesBits<Fx32>(pile(), {2, 3}, {{160, 0xdffce905493eccf4ull}}, "fx32");
+  expectThreadsGiveTheSequencesBits<Fx32>(pile(), {2, 3}, {{160, 0x9e413119af9ade4eull}}, "fx32");
 }
 TEST(SolverIslands, ThreadsGiveTheSequencesBitsFx16) {
-  expectThreadsGiveTheSequencesBits<Fx16>(pile(), {2, 3}, {{160, 0x851001cfea968300ull}}, "fx16");
+  expectThreadsGiveTheSequencesBits<Fx16>(pile(), {2, 3}, {{160, 0xcdc7045ea92d15edull}}, "fx16");
 }
 // float and double: the same bits on every thread count (no golden: their bits are the machine's).
 TEST(SolverIslands, ThreadsGiveTheSequencesBitsFloat) {
@@ -98,12 +100,12 @@ TEST(SolverIslands, ThreadsGiveTheSequencesBitsDouble) {
 // sanitizer build stops at tick 60.
 Scenario largePile() { return loadScenarioFile(test::sourcePath("tests/data/solver_pile_large.json")); }
 TEST(SolverIslands, ALargePileIsPreparedInRangesWithTheSequencesBitsFx32) {
-  std::vector<std::pair<int, uint64_t>> at = {{60, 0xb5d7006ca9c16dc0ull}, {120, 0x58dc8224671d60c5ull}};
+  std::vector<std::pair<int, uint64_t>> at = {{60, 0x523f26168a298cd5ull}, {120, 0xb4f22befa2dc9ee4ull}};
   if (test::slowBuild()) at.pop_back();
   expectThreadsGiveTheSequencesBits<Fx32>(largePile(), {2}, at, "fx32");
 }
 TEST(SolverIslands, ALargePileIsPreparedInRangesWithTheSequencesBitsFx16) {
-  std::vector<std::pair<int, uint64_t>> at = {{60, 0x39b1d2cf5c7556e4ull}, {120, 0x1144ba18df0dc42dull}};
+  std::vector<std::pair<int, uint64_t>> at = {{60, 0xb0663782609ab944ull}, {120, 0x6d5466067d3d96fdull}};
   if (test::slowBuild()) at.pop_back();
   expectThreadsGiveTheSequencesBits<Fx16>(largePile(), {2}, at, "fx16");
 }

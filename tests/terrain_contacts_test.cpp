@@ -259,40 +259,49 @@ TEST(TerrainContacts, BoxRestsOnARidgeDouble) { expectBoxRestsOnARidge<double>("
 // degree past the angle slides straight down the tilt (a pyramid of per-axis limits gave up to
 // sqrt(2) mu N on the diagonal: the 45 deg box held at 1.3 times its friction angle, and the
 // 27 deg one slid along one axis only); a quarter degree short of it, it holds and sleeps.
+// The box square to the world axes, square to the slope, and yawed 20 deg: with the slope and the
+// box's edges both off the axes, a box a quarter degree inside its friction angle slid on at
+// 5.7 cm/s and one past it slid 35 % too far (a slipping corner's friction was not opposite its
+// slip; an independent pass, 2026-11-28).
 template <class S>
 void expectFrictionConeOnTheDiagonal(const char* scalar) {
   const double theta = std::atan(0.25), quarter = 0.25 * std::numbers::pi / 180, seconds = 6;
-  for (const double dirDeg : {26.57, 45.0})
-    for (const bool slide : {true, false}) {
-      const double mu = std::tan(slide ? theta - quarter : theta + quarter);
-      const double dir = dirDeg * std::numbers::pi / 180;
-      Scenario s = test::emptyWorld();
-      s.bodies.gravity = {q12(kG * std::sin(theta) * std::cos(dir)), q12(-kG * std::cos(theta)),
-                          q12(kG * std::sin(theta) * std::sin(dir))};
-      s.bodies.list = {cube(Rational{1, 4}, q12(mu))};
-      auto w = test::makeTyped<S>(s);
-      for (int64_t t = 0; t < std::llround(seconds / kDt); ++t) ASSERT_TRUE(w->step(TickInput{}).ok);
-      const auto& b = w->bodies()[0];
-      const double x = d(b.position.x()), z = d(b.position.z());
-      const double along = x * std::cos(dir) + z * std::sin(dir), across = -x * std::sin(dir) + z * std::cos(dir);
-      const double a = kG * (std::sin(theta) - mu * std::cos(theta)),
-                   expected = slide ? 0.5 * a * seconds * seconds : 0;
-      if (printing())
-        std::printf("[cone %s dir %.0f %s] along %.4f m (a t^2/2 %.4f) across %+.5f m %s\n", scalar, dirDeg,
-                    slide ? "slide" : "hold", along, expected, across, b.asleep ? "asleep" : "awake");
-      if (slide) {
-        // As the friction-angle test on the tangent axes: 10 % (cold start) plus, in fixed
-        // point, two units of friction impulse per sub-step (four corners rounding half a unit).
-        double unitAccel = 0;
-        if constexpr (ScalarTraits<S>::isFixed) unitAccel = 2 * d(S::fromRaw(1)) / (kDt / 4);
-        EXPECT_NEAR(along, expected, 0.10 * expected + unitAccel * seconds * seconds / 2) << scalar << " " << dirDeg;
-        EXPECT_LT(std::fabs(across), 0.01 * expected) << scalar << " " << dirDeg;  // straight down the tilt
-        EXPECT_FALSE(b.asleep) << scalar << " " << dirDeg;
-      } else {
-        EXPECT_LT(std::hypot(along, across), 0.005) << scalar << " " << dirDeg;  // the static-friction creep bound
-        EXPECT_TRUE(b.asleep) << scalar << " " << dirDeg;
+  for (const double dirDeg : {26.57, 37.0, 45.0})
+    for (const double yawDeg : {0.0, -dirDeg, 20.0})
+      for (const bool slide : {true, false}) {
+        const double mu = std::tan(slide ? theta - quarter : theta + quarter);
+        const double dir = dirDeg * std::numbers::pi / 180;
+        Scenario s = test::emptyWorld();
+        s.bodies.gravity = {q12(kG * std::sin(theta) * std::cos(dir)), q12(-kG * std::cos(theta)),
+                            q12(kG * std::sin(theta) * std::sin(dir))};
+        s.bodies.list = {cube(Rational{1, 4}, q12(mu))};
+        const double yaw = yawDeg * std::numbers::pi / 180;
+        s.bodies.list[0].orientation = {q12(std::cos(yaw / 2)), Rational{0, 1}, q12(std::sin(yaw / 2)), Rational{0, 1}};
+        auto w = test::makeTyped<S>(s);
+        for (int64_t t = 0; t < std::llround(seconds / kDt); ++t) ASSERT_TRUE(w->step(TickInput{}).ok);
+        const auto& b = w->bodies()[0];
+        const double x = d(b.position.x()), z = d(b.position.z());
+        const double along = x * std::cos(dir) + z * std::sin(dir), across = -x * std::sin(dir) + z * std::cos(dir);
+        const double a = kG * (std::sin(theta) - mu * std::cos(theta)),
+                     expected = slide ? 0.5 * a * seconds * seconds : 0;
+        if (printing())
+          std::printf("[cone %s dir %.0f yaw %.0f %s] along %.4f m (a t^2/2 %.4f) across %+.5f m %s\n", scalar, dirDeg,
+                      yawDeg, slide ? "slide" : "hold", along, expected, across, b.asleep ? "asleep" : "awake");
+        if (slide) {
+          // As the friction-angle test on the tangent axes: 10 % (cold start) plus, in fixed
+          // point, two units of friction impulse per sub-step (four corners rounding half a unit).
+          double unitAccel = 0;
+          if constexpr (ScalarTraits<S>::isFixed) unitAccel = 2 * d(S::fromRaw(1)) / (kDt / 4);
+          EXPECT_NEAR(along, expected, 0.10 * expected + unitAccel * seconds * seconds / 2)
+              << scalar << " " << dirDeg << " yaw " << yawDeg;
+          EXPECT_LT(std::fabs(across), 0.01 * expected)
+              << scalar << " " << dirDeg << " yaw " << yawDeg;  // straight down
+          EXPECT_FALSE(b.asleep) << scalar << " " << dirDeg << " yaw " << yawDeg;
+        } else {
+          EXPECT_LT(std::hypot(along, across), 0.005) << scalar << " " << dirDeg << " yaw " << yawDeg;  // creep bound
+          EXPECT_TRUE(b.asleep) << scalar << " " << dirDeg << " yaw " << yawDeg;
+        }
       }
-    }
 }
 TEST(TerrainContacts, FrictionConeOnTheDiagonalFx32) { expectFrictionConeOnTheDiagonal<Fx32>("fx32"); }
 TEST(TerrainContacts, FrictionConeOnTheDiagonalFx16) { expectFrictionConeOnTheDiagonal<Fx16>("fx16"); }
