@@ -194,6 +194,18 @@ std::string objError(const std::string& text) {
   return viewer::parseObjMesh(text, "m.obj", &mesh, &error) ? std::string() : error;
 }
 
+TEST(RenderObj, VertexLinesHaveNoTrailingJunk) {
+  // "v 1 2 3 junk" loaded as a vertex (an independent pass, 2026-11-28). v takes x y z, an optional
+  // w, or r g b colours (ignored); vn exactly x y z.
+  const std::string face = "f 1 2 3\n";
+  EXPECT_EQ(objError("v 0 0 0\nv 1 0 0\nv 0 1 0\n" + face), "");
+  EXPECT_EQ(objError("v 0 0 0 1\nv 1 0 0 1\nv 0 1 0 0.5 0.5 0.5\n" + face), "");
+  EXPECT_EQ(objError("v 0 0 0\nv 1 0 0 junk\nv 0 1 0\n" + face),
+            "m.obj:2: expected a finite number within +-1e6, got 'junk'");
+  EXPECT_EQ(objError("v 0 0 0 1 1\n"), "m.obj:1: expected 'v x y z', 'v x y z w' or 'v x y z r g b', got 5 values");
+  EXPECT_EQ(objError("v 0 0 0\nvn 0 0 1 0\n"), "m.obj:2: expected 'vn x y z', got 4 values");
+}
+
 TEST(RenderObj, NumbersOutOfRangeOrNotFiniteAreRefused) {
   // from_chars reports overflow; NaN and infinity parse but are refused; so is a coordinate past
   // 1e6 m (its normal sums would overflow float).

@@ -240,7 +240,8 @@ TEST(InputTrack, ErrorsNameTheFileAndJsonPath) {
     }
     return std::string("no error");
   };
-  EXPECT_EQ(error(R"({"ticks": 3})"), R"(track.json: $.format: expected "simgrass-input-track/1", got null)");
+  EXPECT_EQ(error(R"({"ticks": 3})"),
+            R"(track.json: $.format: expected "simgrass-input-track/1" (the key is missing))");
   EXPECT_EQ(
       error(
           R"({"format": "simgrass-input-track/1", "camera": [{"tick": 5, "position": [0,0,0]}, {"tick": 5, "position": [0,0,0]}]})"),

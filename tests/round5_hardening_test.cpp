@@ -16,6 +16,18 @@ namespace {
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
+/// `simgrass run` of a scenario written into `dir` as `name`, with `args`.
+CliResult runScenario(TempDir& dir, const std::string& name, const std::string& text, const std::string& args) {
+  return runCli("run " + quote(dir.write(name, text)) + " " + args);
+}
+
+/// Refused as bad input: exit 2, one line, saying `phrase`.
+void expectRefused(const CliResult& r, const std::string& phrase) {
+  EXPECT_EQ(r.exitCode, 2) << r.describe();
+  EXPECT_TRUE(isOneLine(r.err));
+  EXPECT_TRUE(contains(r.err, phrase)) << r.err;
+}
+
 /// The options of `simgrass <command> --help` that take a value ("  --name TYPE", one space between
 /// them; a flag's description follows after a wider gap), and its positionals.
 std::vector<std::string> valueOptions(const std::string& command) {
@@ -159,6 +171,33 @@ TEST(Round5Hardening, AFixedPointFaultInTheBodyStagesNamesNoBodyItCannotKnow) {
   EXPECT_TRUE(contains(r.err, "stage 'response': fixed-point overflow")) << r.err;
   EXPECT_FALSE(contains(r.err, ", body 0")) << r.err;
   EXPECT_TRUE(contains(r.err, "$.script[1] (addVelocity to body 1 at tick 2)")) << r.err;
+}
+
+TEST(Round5Hardening, AUnitQuaternionOfManyDigitsIsUnit) {
+  // Squaring a component's exact fraction overflowed 128 bits (a component of -3.52e-18, or
+  // 0.7071 written to 30 digits) and the quaternion was called non-unit.
+  TempDir dir;
+  auto boxTurnedBy = [](const std::string& q) {
+    return R"({"field": {"patchesX": 6, "patchesZ": 6}, "bodies": {"list": [{"name": "b",
+        "shape": {"type": "box", "halfExtents": [0.2, 0.2, 0.2]}, "orientation": )" +
+           q + "}]}}";
+  };
+  for (const std::string q :
+       {"[1, 0, -3.52e-18, 0]", "[0.707106781186547524400844362105, 0, 0.707106781186547524400844362105, 0]"}) {
+    const CliResult r = runScenario(dir, "q.json", boxTurnedBy(q), "--ticks 1");
+    EXPECT_EQ(r.exitCode, 0) << q << "\n" << r.describe();
+  }
+  expectRefused(runScenario(dir, "off.json", boxTurnedBy("[1, 0, 0.1, 0]"), "--ticks 1"),
+                "$.bodies.list[0].orientation: expected a unit quaternion");
+}
+
+TEST(Round5Hardening, AnEmptyFileNameInAScenarioIsSaidSo) {
+  // "file": "" named the scenario's own folder: "expected '' to be a regular file, got a directory".
+  TempDir dir;
+  expectRefused(runScenario(dir, "e.json", R"({"field": {"patchesX": 6, "patchesZ": 6},
+      "terrain": {"type": "heightmap", "file": ""}})",
+                            "--ticks 1"),
+                "$.terrain.file: expected a file name, got an empty string");
 }
 
 }  // namespace

@@ -239,8 +239,10 @@ void parseInput(Recording& r, Cursor& c, TickInput& camera, Ticks& ticks) {
   rec.offset = tickAt;
   rec.tick = c.get<int64_t>("the input tick");
   const int64_t after = r.inputs.empty() ? r.header.startTick - 1 : r.inputs.back().tick;
-  if (rec.tick <= after)
-    c.fail(tickAt, "an input tick after " + std::to_string(after) + ", got " + std::to_string(rec.tick));
+  if (rec.tick <= after)  // the first: at or after the start tick (not "after -1, got -1")
+    c.fail(tickAt, (r.inputs.empty() ? "an input tick from the start tick " + std::to_string(r.header.startTick)
+                                     : "an input tick after " + std::to_string(after)) +
+                       ", got " + std::to_string(rec.tick));
   expectReachable(c, tickAt, rec.tick, ticks, "an input tick");
   expectPromisedBefore(r, c, tickAt, rec.tick, ticks, true, true, false, "the input");
   const uint64_t flagsAt = c.offset();

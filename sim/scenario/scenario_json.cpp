@@ -226,6 +226,8 @@ class Reader {
   /// file is opened, reading "ok.png" for "ok.png\u0000junk" and recording the longer name).
   std::string fileName(const json& j, const std::string& path) const {
     std::string name = string(j, path);
+    // "" named the scenario's own folder ("expected '' to be a regular file, got a directory").
+    if (name.empty()) fail(path, "a file name, got an empty string");
     for (size_t i = 0; i < name.size(); ++i) {
       const auto c = static_cast<unsigned char>(name[i]);
       if (c < 0x20 || c == 0x7f)
@@ -465,11 +467,22 @@ BodySpec parseBody(const Reader& r, const json& j, const std::string& p) {
     b.orientation = r.vector<4>(j["orientation"], p + ".orientation");
     // A unit quaternion, to within 1e-3 in its squared norm (so that 4-digit decimals such as
     // [0.7071, 0, 0.7071, 0] pass); the world normalises it in the scalar (makeBody). A zero or a
-    // clearly non-unit quaternion is a mistake, not a rotation. Checked exactly, in rationals.
-    std::optional<Rational> norm2 = Rational{0, 1};
-    for (const Rational& q : b.orientation)
-      if (norm2) norm2 = add(*norm2, mul(q, q).value_or(Rational{1000, 1}));
-    const bool unit = norm2 && compare(*norm2, Rational{999, 1000}) >= 0 && compare(*norm2, Rational{1001, 1000}) <= 0;
+    // clearly non-unit quaternion is a mistake, not a rotation. Checked in integers, each component
+    // rounded to 2^-40 (an error of 2^-39 in the sum, far inside the 0.001): squaring the exact
+    // fractions overflowed 128 bits for a component of many digits (-3.52e-18, or 0.7071 to 30
+    // digits) and called a unit quaternion non-unit (an independent pass, 2026-11-28).
+    Int128 norm2 = 0;
+    bool unit = true;
+    for (const Rational& q : b.orientation) {
+      const std::optional<Int128> scaled = q.toScaledInteger(40);
+      if (!scaled || *scaled > (Int128(1) << 41) || *scaled < -(Int128(1) << 41)) {
+        unit = false;  // |q| > 2
+        break;
+      }
+      norm2 += *scaled * *scaled;  // <= 4 x 2^82
+    }
+    const Int128 one = Int128(1) << 80;
+    unit = unit && norm2 * 1000 >= one * 999 && norm2 * 1000 <= one * 1001;
     if (!unit)
       r.failGot(p + ".orientation", "a unit quaternion [w, x, y, z] (w^2 + x^2 + y^2 + z^2 = 1 within 0.001)",
                 j["orientation"]);
@@ -804,8 +817,8 @@ InputTrack parseInputTrack(const std::string& text, const std::string& sourceNam
   InputTrack track;
   track.sourceName = sourceName;
   r.object(root, "$", {"format", "ticks", "camera", "commands"});
-  if (!root.contains("format") || root["format"] != "simgrass-input-track/1")
-    r.failGot("$.format", "\"simgrass-input-track/1\"", root.contains("format") ? root["format"] : json());
+  if (!root.contains("format")) r.fail("$.format", "\"simgrass-input-track/1\" (the key is missing)");
+  if (root["format"] != "simgrass-input-track/1") r.failGot("$.format", "\"simgrass-input-track/1\"", root["format"]);
   if (root.contains("ticks")) track.ticks = r.integer(root["ticks"], "$.ticks", 0, kMaxTick);
   if (root.contains("camera")) parseCamera(r, root["camera"], "$.camera", track.camera);
   if (root.contains("commands")) parseScript(r, root["commands"], scenario, "$.commands", track.commands);

@@ -98,6 +98,16 @@ bool parseObjMesh(const std::string& text, const std::string& name, ObjMesh* out
       for (int a = 0; a < 3; ++a)
         if (!parseFloat(w[size_t(a) + 1], &xyz[a]))
           return fail("a finite number within +-1e6, got " + quoted(w[size_t(a) + 1]));
+      // What may follow: v's w (4 numbers) or vertex colours (6), vn nothing; "v 1 2 3 junk"
+      // loaded as if the junk were not there (an independent pass, 2026-11-28).
+      const size_t extra = w.size() - 4;
+      if (w[0] == "vn" ? extra != 0 : extra != 0 && extra != 1 && extra != 3)
+        return fail(std::string(w[0] == "v" ? "'v x y z', 'v x y z w' or 'v x y z r g b'" : "'vn x y z'") + ", got " +
+                    std::to_string(w.size() - 1) + " values");
+      for (size_t a = 4; a < w.size(); ++a) {
+        float ignored = 0;
+        if (!parseFloat(w[a], &ignored)) return fail("a finite number within +-1e6, got " + quoted(w[a]));
+      }
       auto& dst = w[0] == "v" ? v : vn;
       if (dst.size() / 3 >= kMaxVertices) return fail("at most " + std::to_string(kMaxVertices) + " vertices");
       dst.insert(dst.end(), xyz, xyz + 3);
