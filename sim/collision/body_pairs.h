@@ -11,6 +11,7 @@
 #include "sim/bodies/rigid_body.h"
 #include "sim/collision/box_box.h"
 #include "sim/collision/primitives.h"
+#include "sim/collision/swept_spheres.h"
 #include "sim/collision/terrain_contacts.h"
 
 namespace sg {
@@ -60,12 +61,37 @@ std::vector<std::pair<int32_t, int32_t>> bodyPairs(const std::vector<RigidBody<S
   return pairs;
 }
 
+/// A pair's relative motion over a tick: a speculative contact of a sphere part whose straight
+/// path cannot come within `margin` of the other part is a ghost, and is dropped (swept_spheres.h).
+template <class S>
+struct PairSweep {
+  Vec3<S> displacement;  ///< A's motion against B's over the tick, v_A dt - v_B dt (m)
+  S margin;              ///< the speculative distance, and what the straight path leaves out (m): turning, gravity
+};
+
+/// Whether the contacts of a sphere part pair (part `a` of A at pose pa, part `b` of B at pb; one
+/// of them a sphere) can close this tick: false when the sphere's path relative to the other
+/// part stays farther than the sweep's margin from it.
+template <class S>
+bool sphereCanMeet(const BodyPart<S>& a, const Pose<S>& pa, const BodyPart<S>& b, const Pose<S>& pb,
+                   const PairSweep<S>& sweep) {
+  if (a.type == ShapeType::Sphere && b.type == ShapeType::Sphere)
+    return segmentPointDistance(pa.position, sweep.displacement, pb.position) - a.radius - b.radius <= sweep.margin;
+  if (a.type == ShapeType::Sphere) {
+    const Vec3<S> path = pb.rotation.transpose() * sweep.displacement;
+    return segmentBoxDistance(pb.toLocal(pa.position), path, b.halfExtents) - a.radius <= sweep.margin;
+  }
+  const Vec3<S> path = pa.rotation.transpose() * Vec3<S>(-sweep.displacement);  // B's sphere against A's box
+  return segmentBoxDistance(pa.toLocal(pb.position), path, a.halfExtents) - b.radius <= sweep.margin;
+}
+
 /// Contacts between bodies i < j over all their parts; features carry the part index in the
 /// upper 16 bits. Every contact has bodyA = i, bodyB = j. Parts up to `speculative` (m) apart
-/// get speculative contacts (primitives.h).
+/// get speculative contacts (primitives.h); with a `sweep`, a sphere part's speculative contact
+/// farther than its margin is kept only if the sphere's path this tick can reach the other part.
 template <class S>
 void collideBodies(int32_t i, const RigidBody<S>& A, int32_t j, const RigidBody<S>& B, std::vector<Contact<S>>& out,
-                   S speculative = S(0)) {
+                   S speculative = S(0), const PairSweep<S>* sweep = nullptr) {
   for (size_t pi = 0; pi < A.parts.size(); ++pi)
     for (size_t pj = 0; pj < B.parts.size(); ++pj) {
       const BodyPart<S>& a = A.parts[pi];
@@ -87,6 +113,10 @@ void collideBodies(int32_t i, const RigidBody<S>& A, int32_t j, const RigidBody<
       } else {
         collideBoxBox(i, a.halfExtents, pa, j, b.halfExtents, pb, out, speculative);
       }
+      // A sphere part makes one contact; a box pair's manifold is left as it is (no sweep test).
+      if (sweep && out.size() == first + 1 && (a.type == ShapeType::Sphere || b.type == ShapeType::Sphere) &&
+          -out[first].penetration > sweep->margin && !sphereCanMeet(a, pa, b, pb, *sweep))
+        out.resize(first);
       for (size_t k = first; k < out.size(); ++k) {
         out[k].featureA |= uint32_t(pi) << 16;
         out[k].featureB |= uint32_t(pj) << 16;

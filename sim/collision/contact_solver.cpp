@@ -575,7 +575,10 @@ void storeImpulses(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<
   // half second the speed test waits, so it fell asleep; an independent pass, 2026-11-28). A
   // point that holds a body without turning it carries no friction (a ball on level ground: its
   // friction is exactly 0, gravity having no tangential part). More than 1/4096 of the normal
-  // impulse counts: slopes above 0.05 degrees.
+  // impulse counts: slopes above 0.05 degrees. Whether the tick sped the body up does not decide it:
+  // a ball rolling slowly up a slope slows to its turning point there, and would be frozen on the
+  // slope. The price: a ball rocking in a shallow dip (there is no rolling resistance, so it does
+  // rock for ever) stays awake (docs/physics-notes.md).
   std::vector<int32_t> pushingPoints(bodies.size(), 0);
   std::vector<uint8_t> pointTurns(bodies.size(), 0);
   for (const ContactRow<S>& row : rows) {

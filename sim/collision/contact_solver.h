@@ -175,7 +175,7 @@ void applyRestitution(std::vector<RigidBody<S>>& bodies, std::vector<ContactRow<
                       const SolverSettings<S>& settings);
 
 /// Replaces `cache` by this tick's impulses and marks the bodies whose contacts slid or overlap
-/// by more than the slop (RigidBody::heldThisTick false).
+/// by more than the slop, or that one turning point holds (RigidBody::heldThisTick false).
 template <class S>
 void storeImpulses(std::vector<RigidBody<S>>& bodies, const std::vector<Contact<S>>& contacts,
                    const std::vector<ContactRow<S>>& rows, const SolverSettings<S>& settings,
