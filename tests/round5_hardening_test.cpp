@@ -34,6 +34,8 @@ std::vector<std::string> valueOptions(const std::string& command) {
   const CliResult help = runCli(command + " --help");
   EXPECT_EQ(help.exitCode, 0) << help.describe();
   std::vector<std::string> options;
+  // A build without the viewer (the sanitizer build) has a `render` that takes nothing.
+  if (command == "render" && help.out.find("needs a build with the viewer") != std::string::npos) return options;
   const std::regex option(R"(^  (?:-\w,)?(--[\w-]+) [A-Z]+\b)"), positional(R"(^  ([a-z][\w-]*) [A-Z]+\b)");
   std::istringstream lines(help.out);
   for (std::string line; std::getline(lines, line);) {
@@ -51,6 +53,7 @@ TEST(Round5Hardening, EveryOptionRefusesAnEmptyValue) {
   size_t tried = 0;
   for (const std::string command : {"run", "record", "replay", "diff", "compare", "sweep", "render"}) {
     const std::vector<std::string> options = valueOptions(command);
+    if (options.empty() && command == "render") continue;  // the stub of a build without the viewer
     EXPECT_GE(options.size(), 3u) << command << ": the --help parse found too few options";
     std::string positionalsBefore;  // `diff x ''`: the second positional empty, the first not
     for (const std::string& option : options) {
@@ -63,7 +66,7 @@ TEST(Round5Hardening, EveryOptionRefusesAnEmptyValue) {
       ++tried;
     }
   }
-  EXPECT_GE(tried, 60u);
+  EXPECT_GE(tried, 50u);  // 72 with the viewer's render, 61 without
 }
 
 TEST(Round5Hardening, ABladeFileThatAsksForThePushIsRefused) {
