@@ -86,8 +86,9 @@ void World<S>::detectContacts() {
     const RigidBody<S>& b = bodies_[i];  // asleep too: it may be woken below
     const Vec3<S>& v = b.velocity;
     const Vec3<S>& w = b.angularVelocity;
-    turning[i] = length3(w.x(), w.y(), w.z()) * b.boundingRadius * dt;
-    reach[i] = (length3(v.x(), v.y(), v.z()) + length3(w.x(), w.y(), w.z()) * b.boundingRadius + gravityGain) * dt;
+    const S surfaceSpeed = length3(w.x(), w.y(), w.z()) * b.boundingRadius;  // m/s, from turning
+    turning[i] = surfaceSpeed * dt;
+    reach[i] = (length3(v.x(), v.y(), v.z()) + surfaceSpeed + gravityGain) * dt;
     grown[i] = reach[i] + speculativeDistance_ / S(2);
   }
   // Sleeping bodies keep no contacts among themselves or with the terrain; an awake body that

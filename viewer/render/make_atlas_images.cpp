@@ -9,6 +9,7 @@
 #include <string>
 #include <system_error>
 
+#include "replay/cli/option_checks.h"
 #include "sim/scenario/json_bounds.h"
 #include "viewer/render/atlas.h"
 
@@ -38,6 +39,7 @@ int main(int argc, char** argv) {
                        : std::string();
           },
           "SEED"));
+  sg::refuseEmptyValues(app);  // as simgrass and simgrass-viewer: '' is refused by name
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
