@@ -7,7 +7,11 @@
 //                           snapshot restore + snapshotEvery - 1 ticks)
 //   BM_Snapshot             one zstd snapshot; counters give raw and compressed bytes per
 //                           1,000,000 patches
-//   build/release/bench/simgrass_bench --benchmark_filter='Record|Seek|Snapshot'
+//   BM_StateDigest          XXH3-64 (the package's dispatching entry point, as the state hash
+//                           calls it) over 32 KB (one array of a row group, in L1), 196 KB (a
+//                           group's six arrays, in L2) and 1.1 MB (the thesis meadow's particle
+//                           state): the hash's own speed, which bounds what a CHCK every tick costs
+//   build/release/bench/simgrass_bench --benchmark_filter='Record|Seek|Snapshot|StateDigest'
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
@@ -18,6 +22,7 @@
 #include "replay/format/sgr_writer.h"
 #include "replay/player.h"
 #include "replay/recorder.h"
+#include "sim/state/state_hash.h"
 
 namespace {
 
@@ -92,5 +97,18 @@ void BM_Snapshot(benchmark::State& state) {
   state.counters["zstd_MB_per_1M_patches"] = double(compressed) * perMillion / 1e6;
 }
 BENCHMARK(BM_Snapshot)->Arg(151)->Arg(1000)->ArgName("side")->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_StateDigest(benchmark::State& state) {
+  std::vector<uint64_t> values(size_t(state.range(0)) / sizeof(uint64_t));
+  for (size_t i = 0; i < values.size(); ++i) values[i] = i * 0x9E3779B97F4A7C15ull;  // not all alike
+  uint64_t sink = 0;
+  for (auto _ : state) {
+    sink += sg::rowDigest(values.data(), values.size());
+    benchmark::DoNotOptimize(sink);
+  }
+  state.SetBytesProcessed(int64_t(state.iterations()) * state.range(0));
+}
+// 6 x 22,801 x 8 bytes = 1,094,448: the thesis meadow's px..vz in fx32.
+BENCHMARK(BM_StateDigest)->Arg(32 << 10)->Arg(196 << 10)->Arg(1094448)->ArgName("bytes");
 
 }  // namespace

@@ -74,10 +74,51 @@ S sqrtS(S v) {
   return v > S(0) ? S(sqrt(v)) : S(0);
 }
 
+/// fx16 only: an upper bound, in raw Q16.16 units, of |r x dir|^T I^-1 |r x dir| as makeAxis forms
+/// it (every product and partial sum in magnitude, so no step of the real computation exceeds it).
+template <class S>
+uint64_t angularTermBound(const Mat3<S>& invInertiaWorld, const Vec3<S>& arm) {
+  constexpr uint64_t kOne = uint64_t(1) << 16;
+  uint64_t a[3], turn[3];
+  for (int k = 0; k < 3; ++k) a[k] = uint64_t(arm[k].raw() < 0 ? -int64_t(arm[k].raw()) : int64_t(arm[k].raw()));
+  for (int k = 0; k < 3; ++k) {
+    uint64_t sum = 0;  // three products below 2^62 each: below 2^64
+    for (int l = 0; l < 3; ++l) {
+      const int64_t m = invInertiaWorld(k, l).raw();
+      sum += uint64_t(m < 0 ? -m : m) * a[l];
+    }
+    turn[k] = sum / kOne + 1;
+    if (turn[k] >= (uint64_t(1) << 31)) return UINT64_MAX;  // the turn itself would not fit
+  }
+  uint64_t dot = 0;
+  for (int k = 0; k < 3; ++k) dot += a[k] * turn[k];
+  return dot / kOne + 1;
+}
+
 /// The axis `dir` of a contact at arms rA (and rB unless B is the terrain).
 template <class S>
-ContactAxis<S> makeAxis(const Vec3<S>& dir, const RigidBody<S>& A, const Vec3<S>& rA, const RigidBody<S>* B,
-                        const Vec3<S>& rB) {
+ContactAxis<S> makeAxis(const Vec3<S>& dir, const RigidBody<S>& A, Vec3<S> rA, const RigidBody<S>* B, Vec3<S> rB) {
+  if constexpr (ScalarTraits<S>::kind == ScalarKind::Fx16) {
+    // A speculative row's point may lie far out in the gap a fast pair will close this tick (a box
+    // pair's midpoint; a sphere's surface seen from a box), and a light, thin body's angular
+    // terms |r x n|^2 / I at that arm overflow Q16.16 (a 1.8 g plate at 700 m/s, a property
+    // test). The load check (fx16_envelope.h) keeps them in range at arms within the bodies;
+    // beyond that, the arm is halved towards the body's centre until the terms fit: the row
+    // then acts at a point nearer the body, where the surfaces will meet. Every arm that fits
+    // is used as it is (the same bits as before).
+    constexpr uint64_t kLimit = (uint64_t(1) << 31) - 4;
+    for (int halvings = 0; halvings < 40; ++halvings) {
+      const uint64_t termA = angularTermBound(A.invInertiaWorld, Vec3<S>(rA.cross(dir)));
+      const uint64_t termB = B ? angularTermBound(B->invInertiaWorld, Vec3<S>(rB.cross(dir))) : 0;
+      const uint64_t masses = uint64_t(A.invMass.raw()) + (B ? uint64_t(B->invMass.raw()) : 0);
+      if (termA < kLimit && termB < kLimit && masses + termA + termB < kLimit) break;
+      if (termA >= termB) {
+        rA = Vec3<S>(S::fromRaw(rA.x().raw() / 2), S::fromRaw(rA.y().raw() / 2), S::fromRaw(rA.z().raw() / 2));
+      } else {
+        rB = Vec3<S>(S::fromRaw(rB.x().raw() / 2), S::fromRaw(rB.y().raw() / 2), S::fromRaw(rB.z().raw() / 2));
+      }
+    }
+  }
   ContactAxis<S> x;
   x.dir = dir;
   x.armA = rA.cross(dir);

@@ -6,12 +6,13 @@
 
 #include "sim/bodies/rigid_body.h"
 #include "sim/scenario/derived.h"
+#include "sim/scenario/fx16_envelope.h"
 #include "sim/scenario/json_bounds.h"
 
 namespace sg {
 namespace {
 
-/// The largest impulse fx16 holds (N s): Q16.16's largest value.
+/// Q16.16's largest value: the largest 1/mass and 1/inertia fx16 holds.
 constexpr double kFx16MaxImpulse = 32767.0;
 
 /// Why a body's mass properties do not fit S: the first of 1/mass, inertia and 1/inertia (per
@@ -374,20 +375,6 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
       } catch (const std::out_of_range&) {
         throw ScenarioError(s.sourceName, q + ".mass", massPropertiesOutOfRange<S>(b, s, q));
       }
-      // fx16's rigid-body envelope (docs/fixed-point.md): an impulse is at most the format's
-      // largest value, 32,767 N s, so a body must not start with more momentum than a contact can
-      // stop (later overruns stop the tick with an overflow error naming the body).
-      if (ScalarTraits<S>::kind == ScalarKind::Fx16) {
-        double speed2 = 0;
-        for (int c = 0; c < 3; ++c) speed2 += d(b.velocity[size_t(c)]) * d(b.velocity[size_t(c)]);
-        const double momentum = d(b.mass) * std::sqrt(speed2);
-        if (momentum > kFx16MaxImpulse) {
-          std::ostringstream o;
-          o << "a momentum (mass x speed) within fx16's impulse range (<= 32767 N s; docs/fixed-point.md), got "
-            << momentum << " N s";
-          throw ScenarioError(s.sourceName, q + ".velocity", o.str());
-        }
-      }
       if (takeFixedFaults() != 0)
         throw ScenarioError(s.sourceName, q + ".shape",
                             std::string("a body whose shape and mass properties fit the ") +
@@ -426,6 +413,9 @@ void validateForScalar(const Scenario& s, ScalarKind scalar, uint64_t memoryLimi
   own.camera = s.camera;
   own.commands = s.script;
   validateInputTrack(own, scalar, "$.script");
+  // fx16's impact envelope, once every value is known to fit: every contact impulse and inverse
+  // effective mass the scene can produce fits Q16.16 (fx16_envelope.h; docs/fixed-point.md).
+  if (scalar == ScalarKind::Fx16) checkFx16ImpactEnvelope(s);
 }
 
 void validateInputTrack(const InputTrack& track, ScalarKind scalar) { validateInputTrack(track, scalar, "$.commands"); }
