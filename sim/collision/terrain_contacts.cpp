@@ -162,7 +162,7 @@ constexpr int64_t kMaxBoxCells = 256;
 
 template <class S>
 int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& terrain, std::vector<Contact<S>>& out,
-                         S speculative) {
+                         S speculative, const PairSweep<S>* sweep) {
   if (terrain.flat() || ca.y() < terrain.heightAt(ca.x(), ca.z()))
     return spherePlaneUnderCentre(a, ca, ra, terrain, out, speculative);
   const S reach = ra + speculative;
@@ -185,6 +185,12 @@ int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& t
   const size_t first = out.size();
   Vec3<S> n;
   S dist;
+  // A ghost: a contact beyond the margin whose feature the sphere's path this tick never comes
+  // within the margin of (`distanceAt` gives a point's distance to the feature).
+  const auto ghost = [&](S gap, const auto& distanceAt) {
+    return sweep && gap - ra > sweep->margin &&
+           leastDistanceAlong(c, sweep->displacement, distanceAt) - ra > sweep->margin;
+  };
   for (int64_t j = j0; j <= j1 + 1; ++j)
     for (int64_t i = i0; i <= i1 + 1; ++i) {
       const Vec3<S> v00 = vertexAt(terrain, i, j), v10 = vertexAt(terrain, i + 1, j);
@@ -192,25 +198,32 @@ int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& t
       if (i <= i1 && j <= j1) {  // the cell's two faces and its diagonal
         const Vec3<S> v11 = vertexAt(terrain, i + 1, j + 1);
         if (faceContact(terrain, c, reach, v00, S((v10.y() - v00.y()) * inv), S((v01.y() - v00.y()) * inv), i, j, true,
-                        &n, &dist))
+                        &n, &dist) &&
+            !ghost(dist, [&](const Vec3<S>& q) { return pointTriangleDistance(q, v00, v10, v01, n); }))
           addSphereContact(a, ca, ra, featureKey(kLowerFace, i, j), n, dist, out);
         if (faceContact(terrain, c, reach, v11, S((v11.y() - v01.y()) * inv), S((v11.y() - v10.y()) * inv), i, j, false,
-                        &n, &dist))
+                        &n, &dist) &&
+            !ghost(dist, [&](const Vec3<S>& q) { return pointTriangleDistance(q, v11, v10, v01, n); }))
           addSphereContact(a, ca, ra, featureKey(kUpperFace, i, j), n, dist, out);
-        if (edgeContact(terrain, c, reach, v10, v01, i, j, i + 1, j + 1, &n, &dist))
+        if (edgeContact(terrain, c, reach, v10, v01, i, j, i + 1, j + 1, &n, &dist) &&
+            !ghost(dist, [&](const Vec3<S>& q) { return segmentPointDistance(v10, Vec3<S>(v01 - v10), q); }))
           addSphereContact(a, ca, ra, featureKey(kDiagonalEdge, i, j), n, dist, out);
       }
       // The edges from this vertex along +x and +z, with the third corners of their triangles.
-      if (edgeContact(terrain, c, reach, v00, v10, i, j + 1, i + 1, j - 1, &n, &dist))
+      if (edgeContact(terrain, c, reach, v00, v10, i, j + 1, i + 1, j - 1, &n, &dist) &&
+          !ghost(dist, [&](const Vec3<S>& q) { return segmentPointDistance(v00, Vec3<S>(v10 - v00), q); }))
         addSphereContact(a, ca, ra, featureKey(kEdgeAlongX, i, j), n, dist, out);
-      if (edgeContact(terrain, c, reach, v00, v01, i + 1, j, i - 1, j + 1, &n, &dist))
+      if (edgeContact(terrain, c, reach, v00, v01, i + 1, j, i - 1, j + 1, &n, &dist) &&
+          !ghost(dist, [&](const Vec3<S>& q) { return segmentPointDistance(v00, Vec3<S>(v01 - v00), q); }))
         addSphereContact(a, ca, ra, featureKey(kEdgeAlongZ, i, j), n, dist, out);
       const Vec3<S> d = c - v00;
       if (abs(d.x()) >= reach || abs(d.y()) >= reach || abs(d.z()) >= reach) continue;
       dist = length3(d.x(), d.y(), d.z());
       if (!(dist < reach) || dist == S(0)) continue;
       n = d / dist;
-      if (!vertexIsPlanar(terrain, i, j) && vertexIsExtreme(terrain, i, j, v00, n))
+      if (!vertexIsPlanar(terrain, i, j) && vertexIsExtreme(terrain, i, j, v00, n) &&
+          !ghost(dist,
+                 [&](const Vec3<S>& q) { return length3(S(q.x() - v00.x()), S(q.y() - v00.y()), S(q.z() - v00.z())); }))
         addSphereContact(a, ca, ra, featureKey(kVertex, i, j), n, dist, out);
     }
   return int(out.size() - first);
@@ -296,7 +309,8 @@ int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Ter
 }
 
 #define SG_INSTANTIATE(S)                                                                                              \
-  template int collideSphereTerrain(int32_t, const Vec3<S>&, S, const Terrain<S>&, std::vector<Contact<S>>&, S);       \
+  template int collideSphereTerrain(int32_t, const Vec3<S>&, S, const Terrain<S>&, std::vector<Contact<S>>&, S,        \
+                                    const PairSweep<S>*);                                                              \
   template int collideBoxTerrain(int32_t, const Vec3<S>&, const Pose<S>&, const Terrain<S>&, std::vector<Contact<S>>&, \
                                  S);
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE)

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "sim/collision/contact.h"
+#include "sim/collision/swept_spheres.h"
 #include "sim/terrain/terrain.h"
 
 namespace sg {
@@ -19,9 +20,12 @@ namespace sg {
 /// Sphere A against the terrain. On a heightmap: the closest point of every face, edge and vertex
 /// within the sphere's reach; faces whose nearest point lies inside them, edges and vertices only
 /// where they are convex (ridges and peaks). A centre below the ground takes the plane under it.
+/// With a `sweep` (the sphere's path this tick), a contact farther than the sweep's margin is kept
+/// only if that path comes within the margin of its feature (the face, edge or vertex itself, not
+/// the feature's plane: swept_spheres.h).
 template <class S>
 int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& terrain, std::vector<Contact<S>>& out,
-                         S speculative = S(0));
+                         S speculative = S(0), const PairSweep<S>* sweep = nullptr);
 
 /// Box A against the terrain. The eight corners against the triangle under each (thesis: the
 /// corners against the height under them), and the heightmap vertices inside the box that are

@@ -133,9 +133,14 @@ void World<S>::detectContacts() {
   std::vector<std::vector<Contact<S>>> terrainContacts(cuts.size() - 1);
   runCarryingFaults(*pool_, int64_t(cuts.size()) - 1, [&](int64_t c) {
     for (size_t i = cuts[size_t(c)]; i < cuts[size_t(c) + 1]; ++i)
-      if (!bodies_[i].asleep)
+      if (!bodies_[i].asleep) {
+        // A sphere part's ghosts over a heightmap, as against the bodies above: its path over the
+        // tick, widened by its turning and gravity's gain.
+        const PairSweep<S> sweep{Vec3<S>(bodies_[i].velocity * dt),
+                                 speculativeDistance_ + turning[i] + gravityGain * dt};
         collideBodyTerrain(int32_t(i), bodies_[i], terrain_, terrainContacts[size_t(c)],
-                           speculativeDistance_ + reach[i]);
+                           speculativeDistance_ + reach[i], &sweep);
+      }
   });
   for (const std::vector<Contact<S>>& list : terrainContacts)
     contacts_.insert(contacts_.end(), list.begin(), list.end());

@@ -37,25 +37,42 @@ struct EnvelopeBody {
   double dragSpeed = 0;        ///< m/s, what the script's drag spring can give it
   std::string largestCommand;  ///< the script command that adds the most speed ("" if none)
   double largestCommandSpeed = 0;
-  double ownSpeed = 0;  ///< m/s, w: its start, its fall and the script's changes
-  double speed = 0;     ///< m/s, the bound s (filled last)
+  double friction = 0;
+  double spinEnergyPerMass = 0;  ///< J/kg: its start spin's energy, at most I_max |w0|^2 / 2, over m
+  double lowestCentre = 0;       ///< m: how far above the ground its centre of mass stays at least
+  int templateBody = 0;          ///< the listed body whose spec it has (itself, or a spawn's template)
+  double ownSpeed = 0;           ///< m/s, w: its start, its fall and the script's changes
+  double speed = 0;              ///< m/s, the bound s (filled last)
 };
 
-EnvelopeBody fromSpec(const BodySpec& spec, const Scenario& s, const std::string& path) {
+EnvelopeBody fromSpec(const BodySpec& spec, const Scenario& s, const std::string& path, int templateBody) {
   EnvelopeBody e;
   e.path = path;
+  e.templateBody = templateBody;
   e.mass = real(spec.mass);
   e.restitution = real(spec.restitution);
+  e.friction = real(spec.friction);
   const RigidBody<double> body = makeBody<double>(spec, s.timeStep, s.sourceName, path);
-  const double smallestInertia = std::min({body.inertiaLocal.x(), body.inertiaLocal.y(), body.inertiaLocal.z()});
+  const Vec3<double>& inertia = body.inertiaLocal;
+  const double smallestInertia = std::min({inertia.x(), inertia.y(), inertia.z()});
+  const double largestInertia = std::max({inertia.x(), inertia.y(), inertia.z()});
   const double reach = body.boundingRadius;
   e.reach = reach;
   e.invMass = body.invMass;
   e.sphere = body.parts.size() == 1 && body.parts[0].type == ShapeType::Sphere && body.parts[0].offset.isZero();
   e.invInertia = smallestInertia > 0 ? 1.0 / smallestInertia : 0.0;
   e.startSpeed = magnitude(spec.velocity);
-  // The centre of mass lies within the bounding radius of the author's origin.
-  e.top = real(spec.position[1]) + reach;
+  const double spin = magnitude(spec.angularVelocity);
+  e.spinEnergyPerMass = 0.5 * largestInertia * spin * spin * body.invMass;
+  // The centre of mass (the parts' offsets may put it far from the author's origin), and how low
+  // it can come: a lone sphere or box about it keeps it its radius or smallest half extent up.
+  e.top = body.position.y();
+  if (body.parts.size() == 1 && body.parts[0].offset.isZero()) {
+    const BodyPart<double>& part = body.parts[0];
+    e.lowestCentre = part.type == ShapeType::Sphere
+                         ? part.radius
+                         : std::min({part.halfExtents.x(), part.halfExtents.y(), part.halfExtents.z()});
+  }
   return e;
 }
 
@@ -83,17 +100,20 @@ void checkFx16ImpactEnvelope(const Scenario& s) {
   if (s.bodies.list.empty()) return;
   std::vector<EnvelopeBody> bodies;
   for (size_t i = 0; i < s.bodies.list.size(); ++i)
-    bodies.push_back(fromSpec(s.bodies.list[i], s, "$.bodies.list[" + std::to_string(i) + "]"));
+    bodies.push_back(fromSpec(s.bodies.list[i], s, "$.bodies.list[" + std::to_string(i) + "]", int(i)));
   // The script's commands (in tick order, as the world applies them): spawns append bodies,
   // displacements and teleports raise the highest point, velocity changes add speed.
   const double dragOmega = 2.0 * std::numbers::pi * exactToDouble(settings::kDragHertz);
   const double dragReach = std::sqrt(3.0) * exactToDouble(settings::kDragMaxOffset);
   for (const ScriptedCommand& c : s.script) {
     if (c.kind == BodyCommandKind::Spawn) {
-      if (c.body < 0 || size_t(c.body) >= s.bodies.list.size() || bodies.size() >= size_t(kMaxBodies)) continue;
-      const BodySpec& spec = s.bodies.list[size_t(c.body)];
-      EnvelopeBody e = fromSpec(spec, s, "$.script[" + std::to_string(c.source) + "]");
+      // A spawn of a spawned body copies that body's template (the world keeps its spec).
+      if (c.body < 0 || size_t(c.body) >= bodies.size() || bodies.size() >= size_t(kMaxBodies)) continue;
+      const int templateBody = bodies[size_t(c.body)].templateBody;
+      const BodySpec& spec = s.bodies.list[size_t(templateBody)];
+      EnvelopeBody e = fromSpec(spec, s, "$.script[" + std::to_string(c.source) + "]", templateBody);
       e.startSpeed = 0;  // a spawn is at rest, its origin at the command's value
+      e.spinEnergyPerMass = 0;
       e.top += real(c.value[1]) - real(spec.position[1]);
       bodies.push_back(e);
       continue;
@@ -145,8 +165,9 @@ void checkFx16ImpactEnvelope(const Scenario& s) {
   double largestShare = 0;
   std::string largestSource, largestWhat;
   for (EnvelopeBody& e : bodies) {
-    const double drop = std::max(0.0, e.top - ground);
-    const double fall = std::sqrt(e.startSpeed * e.startSpeed + 2.0 * down * drop);
+    const double drop = std::max(0.0, e.top - ground - e.lowestCentre);
+    // Its start spin may turn into speed (a spinning ball put down rolls off).
+    const double fall = std::sqrt(e.startSpeed * e.startSpeed + 2.0 * e.spinEnergyPerMass + 2.0 * down * drop);
     const double own = fall + e.addedSpeed + e.dragSpeed;
     e.ownSpeed = own;
     energy += 0.5 * e.mass * own * own;
@@ -157,10 +178,15 @@ void checkFx16ImpactEnvelope(const Scenario& s) {
       largestShare = scripted, largestSource = e.largestCommand,
       largestWhat = "the script's velocity changes of " + e.path;
     } else if (started > largestShare) {
-      const bool moving = e.startSpeed * e.startSpeed >= 2.0 * down * drop;
-      largestShare = started,
-      largestSource = spawned ? e.path + ".value" : e.path + (moving ? ".velocity" : ".position");
-      largestWhat = moving ? "the start speed of " + e.path : "the fall of " + e.path + " to the lowest ground";
+      const double speedTerm = e.startSpeed * e.startSpeed, spinTerm = 2.0 * e.spinEnergyPerMass,
+                   fallTerm = 2.0 * down * drop;
+      const char* key = speedTerm >= spinTerm && speedTerm >= fallTerm ? ".velocity"
+                        : spinTerm >= fallTerm                         ? ".angularVelocity"
+                                                                       : ".position";
+      largestShare = started, largestSource = spawned ? e.path + ".value" : e.path + key;
+      largestWhat = key[1] == 'v'   ? "the start speed of " + e.path
+                    : key[1] == 'a' ? "the start spin of " + e.path
+                                    : "the fall of " + e.path + " to the lowest ground";
     }
   }
   // Speeds: the energy's bound, or an elastic strike by the fastest other body (at most twice its
@@ -190,12 +216,14 @@ void checkFx16ImpactEnvelope(const Scenario& s) {
     o << "impacts within fx16's impulse range (<= 32767 N s a contact; docs/fixed-point.md): " << e.path
       << (other ? " against " + other->path + ": (1 + restitution) x reduced mass (" + shortNumber(mu) + " kg)"
                 : std::string(" on the ground: (1 + restitution) x mass (") + shortNumber(mu) + " kg)")
-      << " x closing speed may reach " << shortNumber(impulse) << " N s, if the scene's energy (" << shortNumber(energy)
-      << " J, most of it " << largestWhat << ") all goes into " << (other ? "the pair" : "it") << "; use fx32";
+      << " x closing speed (x friction, above 1) may reach " << shortNumber(impulse) << " N s, if the scene's energy ("
+      << shortNumber(energy) << " J, most of it " << largestWhat << ") all goes into " << (other ? "the pair" : "it")
+      << "; use fx32";
     refuseScene(s, largestSource, o.str());
   };
   for (const EnvelopeBody& e : bodies) {
-    const double impulse = (1.0 + e.restitution) * e.mass * e.speed;
+    // Friction holds up to mu of the normal impulse: beyond mu = 1 that is the larger.
+    const double impulse = (1.0 + e.restitution) * e.mass * e.speed * std::max(1.0, e.friction);
     if (!(impulse <= kFx16Largest)) tooLarge(e, nullptr, impulse, e.mass);
     const double k = inverseEffective(e);
     if (!(k <= kFx16Largest)) {
@@ -211,7 +239,8 @@ void checkFx16ImpactEnvelope(const Scenario& s) {
       const EnvelopeBody& a = bodies[i];
       const EnvelopeBody& b = bodies[j];
       const double mu = a.mass * b.mass / (a.mass + b.mass);
-      const double impulse = (1.0 + std::max(a.restitution, b.restitution)) * mu * (a.speed + b.speed);
+      const double impulse = (1.0 + std::max(a.restitution, b.restitution)) * mu * (a.speed + b.speed) *
+                             std::max(1.0, std::sqrt(a.friction * b.friction));
       if (!(impulse <= kFx16Largest)) tooLarge(a, &b, impulse, mu);
       const double k = inverseEffective(a) + inverseEffective(b);
       if (!(k <= kFx16Largest))
