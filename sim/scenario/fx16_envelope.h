@@ -4,22 +4,30 @@
 // inverse effective mass (1/kg) must stay below it for the whole run. Both are bounded at load
 // from the scenario alone:
 //
-//   impulse of a row   <= (1 + e) x mu x (closing speed)     mu = m (terrain), m_a m_b / (m_a + m_b)
+//   impulse of a row   <= (1 + e) x mu x (closing speed) x max(1, friction)
+//                         mu = m (terrain), m_a m_b / (m_a + m_b) (a pair)
 //   closing speed      <= s_a + s_b (terrain: s_a)
-//   s                  =  sqrt(2 E / m) + 3 m/s (the soft push-out) + |g| dt (a tick of fall)
+//   s                  =  min(sqrt(2 E / m), w + 2 w_fastest other) + 3 m/s (push-out) + |g| dt
 //   E                  =  sum over bodies of m w^2 / 2, the most energy the scene can hold
-//   w                  =  sqrt(|v0|^2 + 2 g_down drop) + the script's velocity changes + its drag
-//   drop               =  the highest the body starts or is put (script) above the lowest ground
-//   1/(effective mass) <= 1/m + R^2 / I_min per body (R its bounding radius), summed over a pair
+//   w                  =  sqrt(|v0|^2 + I_max |w0|^2 / m + 2 g_down drop) + the script's velocity
+//                         changes + its drag spring
+//   drop               =  the highest its centre of mass starts or is put (script: displacements,
+//                         teleports, spawns, spawns of spawns) above the lowest ground, less the
+//                         height a lone sphere or box keeps its centre up
+//   1/(effective mass) <= 1/m + R^2 / I_min per body (R its bounding radius; 0 for a sphere's
+//                         angular part), summed over a pair
 //
 // A row's effective mass is at most the pair's reduced mass mu (its angular terms only lower it;
-// a box landing on a corner along its diagonal meets exactly mu), and a row stops at most the
-// pair's closing motion and bounces back e of it. All the energy may reach one body (a heavy
-// body passes its speed on to a light one). What the bound cannot see: gravity off the vertical
-// over unbounded flat ground (a body slides down the tilted pull for as long as the run lasts),
-// a script's velocity change on a body that others have sped up, commands from an input track or
-// the viewer, and bodies wedged between contacts that fight each other; these still stop the tick
-// with the overflow error in stage `response` (never a silently wrong run).
+// a box landing on a corner along its diagonal meets exactly mu), a row stops at most the pair's
+// closing motion, restitution returns e of it and friction holds up to mu of it. All the energy
+// may reach one body (a heavy body passes its speed on to a light one); the strike term keeps a
+// feather beside a fast heavy ball loadable and is not a proof (a chain of ever lighter bodies
+// doubles a speed at each strike). What the bound cannot see: gravity off the vertical over
+// unbounded flat ground, a body travelling beyond the +-32,767 m fx16 holds, commands from an
+// input track or the viewer, a script's velocity change on a body others have sped up, bodies
+// started inside the terrain, heavy long bodies rocking on a heightmap, and a spin near the cap
+// with many sub-steps. These still stop the tick with the overflow error in stage `response`
+// (never a silently wrong run); docs/fixed-point.md lists them with the scenes that showed them.
 #pragma once
 
 #include "sim/scenario/scenario.h"
