@@ -191,6 +191,21 @@ int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& t
     return sweep && gap - ra > sweep->margin &&
            leastDistanceAlong(c, sweep->displacement, distanceAt) - ra > sweep->margin;
   };
+  // Whether a face's plane is the ground where the path first comes within the margin of it: a
+  // planar slope is many triangles, and a ball flying at it obliquely meets a neighbour of the
+  // triangle under its foot; that face's row is real (without it the ball went up to the slop
+  // into the slope before the post-solve sweep caught it). Over a ridge the plane runs on in the
+  // air above the falling ground: a ghost.
+  const auto planeIsGroundAhead = [&](const Vec3<S>& normal, S gap) {
+    const S closing = -dot3(sweep->displacement, normal);  // m this tick towards the plane
+    if (!(closing > S(0))) return false;
+    // The fraction of the tick to that point, at most 1 (divided only below 1: a slow approach's
+    // quotient leaves fx16's range).
+    const S ahead = gap - ra - sweep->margin;
+    const S t = ahead < closing ? S(ahead / closing) : S(1);
+    const Vec3<S> foot = c + sweep->displacement * t - normal * S(gap - closing * t);
+    return abs(S(terrain.heightAt(foot.x(), foot.z()) - foot.y())) <= sweep->margin;
+  };
   for (int64_t j = j0; j <= j1 + 1; ++j)
     for (int64_t i = i0; i <= i1 + 1; ++i) {
       const Vec3<S> v00 = vertexAt(terrain, i, j), v10 = vertexAt(terrain, i + 1, j);
@@ -199,11 +214,13 @@ int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& t
         const Vec3<S> v11 = vertexAt(terrain, i + 1, j + 1);
         if (faceContact(terrain, c, reach, v00, S((v10.y() - v00.y()) * inv), S((v01.y() - v00.y()) * inv), i, j, true,
                         &n, &dist) &&
-            !ghost(dist, [&](const Vec3<S>& q) { return pointTriangleDistance(q, v00, v10, v01, n); }))
+            !(ghost(dist, [&](const Vec3<S>& q) { return pointTriangleDistance(q, v00, v10, v01, n); }) &&
+              !planeIsGroundAhead(n, dist)))
           addSphereContact(a, ca, ra, featureKey(kLowerFace, i, j), n, dist, out);
         if (faceContact(terrain, c, reach, v11, S((v11.y() - v01.y()) * inv), S((v11.y() - v10.y()) * inv), i, j, false,
                         &n, &dist) &&
-            !ghost(dist, [&](const Vec3<S>& q) { return pointTriangleDistance(q, v11, v10, v01, n); }))
+            !(ghost(dist, [&](const Vec3<S>& q) { return pointTriangleDistance(q, v11, v10, v01, n); }) &&
+              !planeIsGroundAhead(n, dist)))
           addSphereContact(a, ca, ra, featureKey(kUpperFace, i, j), n, dist, out);
         if (edgeContact(terrain, c, reach, v10, v01, i, j, i + 1, j + 1, &n, &dist) &&
             !ghost(dist, [&](const Vec3<S>& q) { return segmentPointDistance(v10, Vec3<S>(v01 - v10), q); }))
