@@ -117,8 +117,8 @@ void collideBodies(int32_t i, const RigidBody<S>& A, int32_t j, const RigidBody<
 }
 
 /// Contacts of body i with the terrain over all its parts (speculative up to `speculative` m;
-/// with a `sweep`, a lone sphere's heightmap contacts beyond its margin only where its path this
-/// tick can reach their features: terrain_contacts.h). Not a compound's spheres: one part's
+/// with a `sweep`, a lone sphere's or box's heightmap contacts beyond its margin only where its
+/// path this tick can reach their features: terrain_contacts.h). Not a compound's parts: one part's
 /// contact turns the body within the tick, and the other part's path is then far off its
 /// start-of-tick line (a dumbbell of two 10 cm balls at 300 m/s sank 4.6 m into a hill).
 template <class S>
@@ -131,7 +131,7 @@ void collideBodyTerrain(int32_t i, const RigidBody<S>& A, const Terrain<S>& terr
     if (A.parts[p].type == ShapeType::Sphere)
       collideSphereTerrain(i, pose.position, A.parts[p].radius, terrain, out, speculative, loneSweep);
     else
-      collideBoxTerrain(i, A.parts[p].halfExtents, pose, terrain, out, speculative);
+      collideBoxTerrain(i, A.parts[p].halfExtents, pose, terrain, out, speculative, loneSweep);
     for (size_t k = first; k < out.size(); ++k) out[k].featureA |= uint32_t(p) << 16;
   }
 }

@@ -80,20 +80,20 @@ S segmentBoxDistance(const Vec3<S>& p, const Vec3<S>& d, const Vec3<S>& h) {
 
 /// The distance (m) from q to the triangle a b c whose unit normal is n, for the ground's
 /// triangles (their projections on the x-z plane are not degenerate): the distance to its plane
-/// when q's foot lies inside it (seen from above), else to the nearest of its edges.
+/// when q's foot on the plane lies inside the triangle, else to the nearest of its edges.
 template <class S>
 S pointTriangleDistance(const Vec3<S>& q, const Vec3<S>& a, const Vec3<S>& b, const Vec3<S>& c, const Vec3<S>& n) {
-  // Which side of each edge q lies on, from above (x-z): inside when all agree (or are zero).
+  const S plane = dot3(Vec3<S>(q - a), n);
+  const Vec3<S> foot = q - n * plane;
+  // Which side of each edge the foot lies on, seen from above (x-z): inside when all agree (or
+  // are zero). The foot, not q: under a steep face q's own x-z can lie inside while its nearest
+  // point on the plane is beyond the face.
   const auto side = [&](const Vec3<S>& from, const Vec3<S>& to) {
-    return S((to.x() - from.x()) * (q.z() - from.z()) - (to.z() - from.z()) * (q.x() - from.x()));
+    return S((to.x() - from.x()) * (foot.z() - from.z()) - (to.z() - from.z()) * (foot.x() - from.x()));
   };
   const S ab = side(a, b), bc = side(b, c), ca = side(c, a);
   const bool inside = (ab >= S(0) && bc >= S(0) && ca >= S(0)) || (ab <= S(0) && bc <= S(0) && ca <= S(0));
-  if (inside) {
-    // Along the normal: the vertical gap times n.y (the foot lies inside: the nearest point is it).
-    const S plane = dot3(Vec3<S>(q - a), n);
-    return abs(plane);
-  }
+  if (inside) return abs(plane);
   return std::min({segmentPointDistance(a, Vec3<S>(b - a), q), segmentPointDistance(b, Vec3<S>(c - b), q),
                    segmentPointDistance(c, Vec3<S>(a - c), q)});
 }

@@ -150,6 +150,42 @@ bool faceContact(const Terrain<S>& t, const Vec3<S>& c, S reach, const Vec3<S>& 
   return fx == ix && fz == iz && fLower == lower;
 }
 
+/// Whether a face's plane is the ground where a path (from c, a sphere of radius ra, `gap` from
+/// the plane along `normal`) first comes within the sweep's margin of it. A planar slope is many
+/// triangles, and a ball flying at it obliquely meets a neighbour of the triangle under its foot:
+/// that face's row is real (without it the ball went up to the slop into the slope before the
+/// post-solve sweep caught it). Over a ridge the plane runs on in the air above the falling
+/// ground: a ghost.
+template <class S>
+bool planeIsGroundAhead(const Terrain<S>& terrain, const Vec3<S>& c, S ra, const Vec3<S>& normal, S gap,
+                        const PairSweep<S>& sweep) {
+  const S closing = -dot3(sweep.displacement, normal);  // m this tick towards the plane
+  if (!(closing > S(0))) return false;
+  // The fraction of the tick to that point, at most 1 (divided only below 1: a slow approach's
+  // quotient leaves fx16's range).
+  const S ahead = gap - ra - sweep.margin;
+  const S t = ahead < closing ? S(ahead / closing) : S(1);
+  const Vec3<S> foot = c + sweep.displacement * t - normal * S(gap - closing * t);
+  return abs(S(terrain.heightAt(foot.x(), foot.z()) - foot.y())) <= sweep.margin;
+}
+
+/// A box corner's speculative row against the triangle under it is a ghost when the corner's path
+/// this tick never comes within the margin of that triangle and the plane is not the ground where
+/// the path nears it (as a sphere's face rows: collideSphereTerrain).
+template <class S>
+bool cornerIsGhost(const Terrain<S>& terrain, const Vec3<S>& p, const Vec3<S>& normal, S gap,
+                   const PairSweep<S>& sweep) {
+  if (!(gap > sweep.margin)) return false;
+  int64_t ix = 0, iz = 0;
+  bool lower = false;
+  terrain.triangleAt(p.x(), p.z(), &ix, &iz, &lower);
+  const Vec3<S> v10 = vertexAt(terrain, ix + 1, iz), v01 = vertexAt(terrain, ix, iz + 1);
+  const Vec3<S> v0 = lower ? vertexAt(terrain, ix, iz) : vertexAt(terrain, ix + 1, iz + 1);
+  const S nearest = leastDistanceAlong(
+      p, sweep.displacement, [&](const Vec3<S>& q) { return pointTriangleDistance(q, v0, v10, v01, normal); });
+  return nearest > sweep.margin && !planeIsGroundAhead(terrain, p, S(0), normal, gap, sweep);
+}
+
 /// Most cells a sphere's reach may span along an axis before it takes the plane under its centre
 /// instead (a fast or huge sphere over fine cells: the cost is the square of this).
 constexpr int64_t kMaxReachCells = 64;
@@ -191,21 +227,6 @@ int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& t
     return sweep && gap - ra > sweep->margin &&
            leastDistanceAlong(c, sweep->displacement, distanceAt) - ra > sweep->margin;
   };
-  // Whether a face's plane is the ground where the path first comes within the margin of it: a
-  // planar slope is many triangles, and a ball flying at it obliquely meets a neighbour of the
-  // triangle under its foot; that face's row is real (without it the ball went up to the slop
-  // into the slope before the post-solve sweep caught it). Over a ridge the plane runs on in the
-  // air above the falling ground: a ghost.
-  const auto planeIsGroundAhead = [&](const Vec3<S>& normal, S gap) {
-    const S closing = -dot3(sweep->displacement, normal);  // m this tick towards the plane
-    if (!(closing > S(0))) return false;
-    // The fraction of the tick to that point, at most 1 (divided only below 1: a slow approach's
-    // quotient leaves fx16's range).
-    const S ahead = gap - ra - sweep->margin;
-    const S t = ahead < closing ? S(ahead / closing) : S(1);
-    const Vec3<S> foot = c + sweep->displacement * t - normal * S(gap - closing * t);
-    return abs(S(terrain.heightAt(foot.x(), foot.z()) - foot.y())) <= sweep->margin;
-  };
   for (int64_t j = j0; j <= j1 + 1; ++j)
     for (int64_t i = i0; i <= i1 + 1; ++i) {
       const Vec3<S> v00 = vertexAt(terrain, i, j), v10 = vertexAt(terrain, i + 1, j);
@@ -215,12 +236,12 @@ int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& t
         if (faceContact(terrain, c, reach, v00, S((v10.y() - v00.y()) * inv), S((v01.y() - v00.y()) * inv), i, j, true,
                         &n, &dist) &&
             !(ghost(dist, [&](const Vec3<S>& q) { return pointTriangleDistance(q, v00, v10, v01, n); }) &&
-              !planeIsGroundAhead(n, dist)))
+              !planeIsGroundAhead(terrain, c, ra, n, dist, *sweep)))
           addSphereContact(a, ca, ra, featureKey(kLowerFace, i, j), n, dist, out);
         if (faceContact(terrain, c, reach, v11, S((v11.y() - v01.y()) * inv), S((v11.y() - v10.y()) * inv), i, j, false,
                         &n, &dist) &&
             !(ghost(dist, [&](const Vec3<S>& q) { return pointTriangleDistance(q, v11, v10, v01, n); }) &&
-              !planeIsGroundAhead(n, dist)))
+              !planeIsGroundAhead(terrain, c, ra, n, dist, *sweep)))
           addSphereContact(a, ca, ra, featureKey(kUpperFace, i, j), n, dist, out);
         if (edgeContact(terrain, c, reach, v10, v01, i, j, i + 1, j + 1, &n, &dist) &&
             !ghost(dist, [&](const Vec3<S>& q) { return segmentPointDistance(v10, Vec3<S>(v01 - v10), q); }))
@@ -248,7 +269,7 @@ int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& t
 
 template <class S>
 int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Terrain<S>& terrain,
-                      std::vector<Contact<S>>& out, S speculative) {
+                      std::vector<Contact<S>>& out, S speculative, const PairSweep<S>* sweep) {
   int added = 0;
   // 1. Corners against the triangle under each (exact distance to its plane).
   for (uint32_t corner = 0; corner < 8; ++corner) {
@@ -259,6 +280,7 @@ int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Ter
     if (p.y() - h >= speculative) continue;  // the vertical gap bounds the gap along the normal
     Vec3<S> n;
     terrain.normalAt(p.x(), p.z(), &n.x(), &n.y(), &n.z());
+    if (sweep && !terrain.flat() && cornerIsGhost(terrain, p, n, S((p.y() - h) * n.y()), *sweep)) continue;
     Contact<S> c;
     c.bodyA = a;
     c.bodyB = kTerrainBody;
@@ -329,7 +351,7 @@ int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Ter
   template int collideSphereTerrain(int32_t, const Vec3<S>&, S, const Terrain<S>&, std::vector<Contact<S>>&, S,        \
                                     const PairSweep<S>*);                                                              \
   template int collideBoxTerrain(int32_t, const Vec3<S>&, const Pose<S>&, const Terrain<S>&, std::vector<Contact<S>>&, \
-                                 S);
+                                 S, const PairSweep<S>*);
 SG_FOR_EACH_SCALAR(SG_INSTANTIATE)
 #undef SG_INSTANTIATE
 }  // namespace sg

@@ -34,8 +34,11 @@ int collideSphereTerrain(int32_t a, const Vec3<S>& ca, S ra, const Terrain<S>& t
 /// `speculative` above the ground are speculative contacts; vertices only overlap.
 /// Not covered: a ridge edge crossing a box face with none of its vertices inside the box (a box
 /// smaller than a cell lying across a ridge sinks onto it until a corner meets the ground).
+/// With a `sweep` (the box's path this tick), a corner's row farther than the margin is kept only
+/// if the corner's path comes within the margin of the triangle under it, or the triangle's plane
+/// is the ground where the path nears it (a ghost otherwise: swept_spheres.h).
 template <class S>
 int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Terrain<S>& terrain,
-                      std::vector<Contact<S>>& out, S speculative = S(0));
+                      std::vector<Contact<S>>& out, S speculative = S(0), const PairSweep<S>* sweep = nullptr);
 
 }  // namespace sg
