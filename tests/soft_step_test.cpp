@@ -643,6 +643,47 @@ void expectNoGhostCollisionsOverARidge(const char* name) {
         }
       }
 }
+// The far face of a steep ridge: a face whose foot lies inside it while the ball is on the other
+// side of the ridge made a row of deep overlap (an independent review, 2026-11-28). A ball 1.6 m
+// from a 1 m ridge of 0.25 m cells, flying away from it at 300 m/s, came out at (-12.6, 50.4) m/s;
+// a ball at rest 1.7 cm from a 3 m blade of 0.1 m cells was pulled into it and thrown 6.5 m up.
+template <class S>
+void expectNoRowFromARidgesFarFace(const char* name) {
+  const auto ridge = [](int width, int height, int column, Rational cell, Rational top) {
+    Scenario s = emptyWorld();
+    s.terrain.flat = false;
+    s.terrain.cellSize = cell;
+    s.terrain.maxHeight = top;
+    s.terrain.heightmap.width = width;
+    s.terrain.heightmap.height = height;
+    s.terrain.heightmap.samples.assign(size_t(width * height), 0);
+    for (int z = 0; z < height; ++z) s.terrain.heightmap.samples[size_t(z * width + column)] = 255;
+    return s;
+  };
+  Scenario away = ridge(64, 8, 32, Rational{1, 4}, Rational{1, 1});  // the ridge at x = 0.125 m
+  away.bodies.gravity = r3(0, 0, 0);
+  away.bodies.list = {test::sphere("ball", mm(50), at(-1500, 300, 500))};
+  away.bodies.list[0].velocity = {Rational{-300, 1}, Rational{0, 1}, Rational{0, 1}};
+  auto w = makeTyped<S>(away);
+  for (int t = 0; t < 3; ++t) {
+    ASSERT_TRUE(w->step(TickInput{}).ok) << name;
+    EXPECT_EQ(d(w->bodies()[0].velocity.x()), -300.0) << name << ": flying away, tick " << t;
+    EXPECT_EQ(d(w->bodies()[0].velocity.y()), 0.0) << name << ": flying away, tick " << t;
+  }
+  Scenario blade = ridge(16, 16, 8, Rational{1, 10}, Rational{3, 1});  // the blade at x = 0.05 m
+  blade.bodies.list = {test::sphere("ball", mm(100), at(-70, 2900, -70))};
+  auto v = makeTyped<S>(blade);
+  double highest = 0;
+  for (int t = 0; t < 120; ++t) {
+    ASSERT_TRUE(v->step(TickInput{}).ok) << name;
+    highest = std::max(highest, d(v->bodies()[0].position.y()));
+  }
+  EXPECT_LE(highest, 2.9 + 1e-3) << name << ": a ball beside a blade only falls";
+}
+TEST(SoftStep, NoRowFromARidgesFarFaceFx32) { expectNoRowFromARidgesFarFace<Fx32>("fx32"); }
+TEST(SoftStep, NoRowFromARidgesFarFaceFx16) { expectNoRowFromARidgesFarFace<Fx16>("fx16"); }
+TEST(SoftStep, NoRowFromARidgesFarFaceDouble) { expectNoRowFromARidgesFarFace<double>("double"); }
+
 TEST(SoftStep, NoGhostCollisionsOverARidgeFx32) { expectNoGhostCollisionsOverARidge<Fx32>("fx32"); }
 TEST(SoftStep, NoGhostCollisionsOverARidgeFx16) { expectNoGhostCollisionsOverARidge<Fx16>("fx16"); }
 TEST(SoftStep, NoGhostCollisionsOverARidgeDouble) { expectNoGhostCollisionsOverARidge<double>("double"); }

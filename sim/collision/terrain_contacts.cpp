@@ -142,7 +142,12 @@ bool faceContact(const Terrain<S>& t, const Vec3<S>& c, S reach, const Vec3<S>& 
                  int64_t iz, bool lower, Vec3<S>* normal, S* dist) {
   *normal = faceNormal(dhdx, dhdz);
   *dist = (c - v).dot(*normal);
-  if (!(*dist < reach)) return false;
+  // Behind the face's plane with the centre above the ground (a centre below it takes the plane
+  // under it instead): the far face of a steep ridge, whose foot lies inside it although the
+  // ball is on the other side. Its row, a deep overlap, threw a ball flying away from a ridge 1.6 m
+  // off to (-12.6, 50.4) m/s, and pulled a ball resting 1.7 cm from a steep blade into it and up
+  // to 6.5 m (an independent review, 2026-11-28). The crest's edge and vertex rows hold there.
+  if (!(*dist < reach) || *dist < S(0)) return false;
   const Vec3<S> foot = c - *normal * *dist;
   int64_t fx = 0, fz = 0;
   bool fLower = false;
