@@ -981,8 +981,8 @@ TEST(SoftStep, Fx16EnvelopeIsCheckedAtLoadAndHoldsInside) {
   EXPECT_NE(e4.find("$.bodies.list[0].position"), std::string::npos) << e4;
   EXPECT_NE(e4.find("the fall of $.bodies.list[0]"), std::string::npos) << e4;
   EXPECT_EQ(loadError(heavy, ScalarKind::Fx32), "");
-  // Inside: a 1,500 kg block dropped from 1 m (at most 10.1 m/s with the push-out and a tick of
-  // fall: 15,200 N s) comes to rest on the ground, and a box spun at 300 rad/s (the gyroscopic
+  // Inside: a 1,500 kg block dropped from 1 m (at most 4.6 m/s with a tick of fall; with the
+  // 3 m/s push-out 11,400 N s) comes to rest on the ground, and a box spun at 300 rad/s (the gyroscopic
   // term used to overflow above ~180 rad/s) keeps stepping.
   Scenario block = emptyWorld();
   block.bodies.list = {box("block", half(500, 500, 500), at(0, 1500, 0), Rational{1500, 1})};
@@ -1081,6 +1081,16 @@ TEST(SoftStep, Fx16RefusesAtLoadWhatUsedToOverflowInTheRun) {
   EXPECT_EQ(loadError(one(grippy), ScalarKind::Fx16), "");
   EXPECT_EQ(loadError(one(box("van", half(2500, 1000, 1000), at(0, 1000, 0), Rational{3000, 1})), ScalarKind::Fx16),
             "");
+  // An 8 t block at rest on the ground loads (restitution returns the approach, not the 3 m/s
+  // push-out); with friction 2 it is refused, and with no energy in the scene the message names
+  // its mass, not an empty path (a last review).
+  BodySpec block = box("block", half(500, 500, 500), at(0, 500, 0), Rational{8000, 1});
+  block.restitution = Rational{3, 10};
+  EXPECT_EQ(loadError(one(block), ScalarKind::Fx16), "");
+  block.friction = Rational{2, 1};
+  const std::string e8 = loadError(one(block), ScalarKind::Fx16);
+  EXPECT_NE(e8.find("$.bodies.list[0].mass: expected"), std::string::npos) << e8;
+  EXPECT_NE(e8.find("push-out and a tick of fall alone"), std::string::npos) << e8;
 }
 
 // The envelope's promise, tried on random scenes: whatever fx16 loads steps without an overflow.

@@ -4,10 +4,10 @@
 // inverse effective mass (1/kg) must stay below it for the whole run. Both are bounded at load
 // from the scenario alone:
 //
-//   impulse of a row   <= (1 + e) x mu x (closing speed) x max(1, friction)
+//   impulse of a row   <= mu x ((1 + e) x closing speed + 3 m/s push-out) x max(1, friction)
 //                         mu = m (terrain), m_a m_b / (m_a + m_b) (a pair)
 //   closing speed      <= s_a + s_b (terrain: s_a)
-//   s                  =  min(sqrt(2 E / m), w + 2 w_fastest other) + 3 m/s (push-out) + |g| dt
+//   s                  =  min(sqrt(2 E / m), w + 2 w_fastest other) + |g| dt
 //   E                  =  sum over bodies of m w^2 / 2, the most energy the scene can hold
 //   w                  =  sqrt(|v0|^2 + I_max |w0|^2 / m + 2 g_down drop) + the script's velocity
 //                         changes + its drag spring
