@@ -496,7 +496,9 @@ TEST(TerrainContacts, RandomSpikyScenesStep) {
     EXPECT_EQ(runRandomScene<Fx32>(seed, &refused), 0) << "fx32 seed " << seed;
     EXPECT_FALSE(refused) << "fx32 seed " << seed;
     EXPECT_EQ(runRandomScene<double>(seed, &refused), 0) << "double seed " << seed;
-    stopped16 += runRandomScene<Fx16>(seed, &refused);
+    const int stopped = runRandomScene<Fx16>(seed, &refused);
+    if (stopped > 0 && printing()) std::printf("[random scenes] fx16 seed %u stopped\n", seed);
+    stopped16 += stopped;
     refused16 += refused ? 1 : 0;
   }
   if (printing())
