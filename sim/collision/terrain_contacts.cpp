@@ -199,6 +199,111 @@ constexpr int64_t kMaxReachCells = 64;
 /// 5 cm cells is 200): beyond it the box meets the ground with its corners only.
 constexpr int64_t kMaxBoxCells = 256;
 
+/// The face of a box (0 to 5: +x, -x, +y, -y, +z, -z in its own frame) through which the ground
+/// pushes a feature out with the least depth, among the faces whose inward normal n (world) the
+/// feature can push along (`pushable(n)`); -1 when none can. depthBelow(axis, side) is the
+/// feature's depth below that face (m).
+template <class S, class DepthBelow, class Pushable>
+int shallowestFace(const Pose<S>& pose, const DepthBelow& depthBelow, const Pushable& pushable, S* depth,
+                   Vec3<S>* normal) {
+  int best = -1;
+  for (int face = 0; face < 6; ++face) {
+    const int axis = face / 2;
+    const S side = face % 2 == 0 ? S(1) : S(-1);
+    const S d = depthBelow(axis, side);
+    if (best >= 0 && !(d < *depth)) continue;
+    Vec3<S> outward = Vec3<S>::Zero();
+    outward[axis] = side;
+    const Vec3<S> n = -(pose.rotation * outward);  // the ground pushes the box away from that face
+    if (!pushable(n)) continue;
+    best = face;
+    *depth = d;
+    *normal = n;
+  }
+  return best;
+}
+
+/// The part [t0, t1] of segment la + t (lb - la), t in [0, 1], strictly inside the box of half
+/// extents ha (box coordinates); false when none is.
+template <class S>
+bool clipSegmentToBox(const Vec3<S>& la, const Vec3<S>& lb, const Vec3<S>& ha, S* t0, S* t1) {
+  *t0 = S(0);
+  *t1 = S(1);
+  for (int k = 0; k < 3; ++k) {
+    const S d = lb[k] - la[k];
+    if (d == S(0)) {
+      if (!(abs(la[k]) < ha[k])) return false;
+      continue;
+    }
+    S enter = (-ha[k] - la[k]) / d, leave = (ha[k] - la[k]) / d;
+    if (d < S(0)) std::swap(enter, leave);
+    *t0 = maxS(*t0, enter);
+    *t1 = minS(*t1, leave);
+    if (!(*t0 < *t1)) return false;
+  }
+  return true;
+}
+
+/// Ground edge (ai, aj)-(bi, bj), whose two triangles' third corners are f1 and f2, against a box
+/// (step 3 of collideBoxTerrain): where the edge is a convex crease and passes through the box with
+/// neither end inside, the part inside is pushed out through the face that takes the least depth
+/// among those the crease can push (the face's inward normal, made normal to the edge, lies in the
+/// crease's wedge: both third corners lie no more than the margin above the plane through the edge
+/// normal to it). One contact at each end of that part, each at its own depth. A planar crease
+/// (the two triangles in one plane) is no feature, as vertexIsPlanar's vertices are not: boxes
+/// slide over planar heightmaps on their corners alone; nor is a valley's.
+template <class S>
+int creaseThroughBox(int32_t body, const Vec3<S>& ha, const Pose<S>& pose, const Vec3<S>& shift, const Terrain<S>& t,
+                     int64_t ai, int64_t aj, int64_t bi, int64_t bj, int64_t f1i, int64_t f1j, int64_t f2i, int64_t f2j,
+                     uint32_t featureB, std::vector<Contact<S>>& out) {
+  const Vec3<S> a = vertexAt(t, ai, aj), b = vertexAt(t, bi, bj);
+  const Vec3<S> la = pose.toLocal(a), lb = pose.toLocal(b);
+  for (int k = 0; k < 3; ++k)  // both ends beyond one face: the common case, no division
+    if ((la[k] >= ha[k] && lb[k] >= ha[k]) || (la[k] <= -ha[k] && lb[k] <= -ha[k])) return 0;
+  const auto inside = [&](const Vec3<S>& l) {
+    return abs(l.x()) < ha.x() && abs(l.y()) < ha.y() && abs(l.z()) < ha.z();
+  };
+  if (inside(la) || inside(lb)) return 0;  // step 2's vertex contacts hold it
+  const Vec3<S> f1 = vertexAt(t, f1i, f1j), f2 = vertexAt(t, f2i, f2j);
+  // The third corners are symmetric about the edge's midpoint: the crease is convex (a ridge,
+  // which has a wedge of normals) when they lie lower on average than the edge, planar when level
+  // with it, and concave (a valley: no normal at all, the ground is solid below) when higher.
+  if (!(f1.y() + f2.y() < a.y() + b.y() - planarMargin<S>())) return 0;
+  S t0, t1;
+  if (!clipSegmentToBox(la, lb, ha, &t0, &t1)) return 0;
+  const Vec3<S> l0 = la + (lb - la) * t0, l1 = la + (lb - la) * t1;
+  const Vec3<S> edge = b - a;
+  const S edgeLength2 = edge.dot(edge);
+  const S margin = convexMargin(t);
+  S bestDepth{};
+  Vec3<S> bestNormal = Vec3<S>::UnitY();
+  const int bestFace = shallowestFace(
+      pose, [&](int axis, S side) { return maxS(S(ha[axis] - side * l0[axis]), S(ha[axis] - side * l1[axis])); },
+      [&](const Vec3<S>& n) {
+        const Vec3<S> across = n - edge * S(edge.dot(n) / edgeLength2);  // n made normal to the edge
+        return !((f1 - a).dot(across) > margin) && !((f2 - a).dot(across) > margin);
+      },
+      &bestDepth, &bestNormal);
+  if (bestFace < 0) return 0;
+  const int axis = bestFace / 2;
+  const S side = bestFace % 2 == 0 ? S(1) : S(-1);
+  int added = 0;
+  for (int end = 0; end < 2; ++end) {
+    const Vec3<S>& l = end == 0 ? l0 : l1;
+    Contact<S> c;
+    c.bodyA = body;
+    c.bodyB = kTerrainBody;
+    c.featureA = 14 + uint32_t(2 * bestFace + end);
+    c.featureB = featureB;
+    c.normal = bestNormal;
+    c.penetration = ha[axis] - side * l[axis];
+    c.point = pose.toWorld(l) + shift;
+    out.push_back(c);
+    ++added;
+  }
+  return added;
+}
+
 }  // namespace
 
 template <class S>
@@ -321,22 +426,11 @@ int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Ter
       const Vec3<S> local = pose.toLocal(v);
       if (abs(local.x()) >= ha.x() || abs(local.y()) >= ha.y() || abs(local.z()) >= ha.z()) continue;
       if (vertexIsPlanar(terrain, i, j)) continue;
-      int bestFace = -1;
       S bestDepth{};
       Vec3<S> bestNormal = Vec3<S>::UnitY();
-      for (int face = 0; face < 6; ++face) {
-        const int axis = face / 2;
-        const S side = face % 2 == 0 ? S(1) : S(-1);
-        const S depth = ha[axis] - side * local[axis];  // below that face (m)
-        if (bestFace >= 0 && !(depth < bestDepth)) continue;
-        Vec3<S> outward = Vec3<S>::Zero();
-        outward[axis] = side;
-        const Vec3<S> n = -(pose.rotation * outward);  // the ground pushes the box away from that face
-        if (!vertexIsExtreme(terrain, i, j, v, n)) continue;
-        bestFace = face;
-        bestDepth = depth;
-        bestNormal = n;
-      }
+      const int bestFace = shallowestFace(
+          pose, [&](int axis, S side) { return S(ha[axis] - side * local[axis]); },
+          [&](const Vec3<S>& n) { return vertexIsExtreme(terrain, i, j, v, n); }, &bestDepth, &bestNormal);
       if (bestFace < 0) continue;
       Contact<S> c;
       c.bodyA = a;
@@ -348,6 +442,19 @@ int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Ter
       c.point = v + shift;
       out.push_back(c);
       ++added;
+    }
+  // 3. Crease edges that pass through the box with neither end inside it: a ridge under a box
+  // narrower than a cell, or crossing it between two samples. Neither the corners (they hang over
+  // the slopes) nor the vertices (none is inside) meet it, and a 0.2 m cube on a 1 m ridge sank
+  // until its corners reached the slopes, the crest 10 cm inside it.
+  for (int64_t j = j0; j <= j1; ++j)
+    for (int64_t i = i0; i <= i1; ++i) {
+      added += creaseThroughBox(a, ha, pose, shift, terrain, i, j, i + 1, j, i, j + 1, i + 1, j - 1,
+                                featureKey(kEdgeAlongX, i, j), out);
+      added += creaseThroughBox(a, ha, pose, shift, terrain, i, j, i, j + 1, i + 1, j, i - 1, j + 1,
+                                featureKey(kEdgeAlongZ, i, j), out);
+      added += creaseThroughBox(a, ha, pose, shift, terrain, i + 1, j, i, j + 1, i, j, i + 1, j + 1,
+                                featureKey(kDiagonalEdge, i, j), out);
     }
   return added;
 }

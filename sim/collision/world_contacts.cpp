@@ -11,6 +11,7 @@
 #include "sim/collision/body_pairs.h"
 #include "sim/collision/continuous_terrain.h"
 #include "sim/collision/solver_islands.h"
+#include "sim/world/settings.h"
 #include "sim/world/world.h"
 #include "sim/world/world_rows.h"
 
@@ -120,6 +121,7 @@ void World<S>::detectContacts() {
       const PairSweep<S> sweep{Vec3<S>(a.velocity * dt - b.velocity * dt),
                                speculativeDistance_ + turning[size_t(i)] + turning[size_t(j)] + gravityGain * dt};
       collideBodies(i, a, j, b, contacts_, speculativeDistance_ + reach[size_t(i)] + reach[size_t(j)], &sweep);
+      if (int64_t(contacts_.size()) > settings::kMaxContacts) return failWithTooManyContacts(i);
       if (contacts_.size() > before && (a.asleep || b.asleep)) {
         wakeIsland(a.asleep ? i : j);
         woke = true;
@@ -133,7 +135,7 @@ void World<S>::detectContacts() {
   std::vector<std::vector<Contact<S>>> terrainContacts(cuts.size() - 1);
   runCarryingFaults(*pool_, int64_t(cuts.size()) - 1, [&](int64_t c) {
     for (size_t i = cuts[size_t(c)]; i < cuts[size_t(c) + 1]; ++i)
-      if (!bodies_[i].asleep) {
+      if (!bodies_[i].asleep && int64_t(terrainContacts[size_t(c)].size()) <= settings::kMaxContacts) {
         // A sphere part's ghosts over a heightmap, as against the bodies above: its path over the
         // tick, widened by its turning and gravity's gain.
         const PairSweep<S> sweep{Vec3<S>(bodies_[i].velocity * dt),
@@ -142,9 +144,26 @@ void World<S>::detectContacts() {
                            speculativeDistance_ + reach[i], &sweep);
       }
   });
+  // A range stops once its own list is past the budget, so the total is past it exactly when the
+  // whole pass's would be: the same verdict for any thread count.
+  size_t total = contacts_.size();
+  for (const std::vector<Contact<S>>& list : terrainContacts) total += list.size();
+  if (int64_t(total) > settings::kMaxContacts) return failWithTooManyContacts(-1);
   for (const std::vector<Contact<S>>& list : terrainContacts)
     contacts_.insert(contacts_.end(), list.begin(), list.end());
   sortContacts(contacts_);
+}
+
+template <class S>
+void World<S>::failWithTooManyContacts(int32_t body) {
+  contacts_.clear();
+  failed_ = true;
+  failure_ = SimError{};
+  failure_.tick = tick_;
+  failure_.stage = Stage::Collision;
+  failure_.body = body >= 0 ? body : kSomeBody;
+  failure_.what = "more than " + std::to_string(settings::kMaxContacts) +
+                  " contacts (bodies heaped inside one another; docs/robustness.md)";
 }
 
 template <class S>
@@ -284,6 +303,7 @@ bool World<S>::applyGrassDrag(const std::vector<int64_t>& pushedPerBody) {
 
 #define SG_INSTANTIATE_CONTACTS(S)                                 \
   template void World<S>::detectContacts();                        \
+  template void World<S>::failWithTooManyContacts(int32_t);        \
   template bool World<S>::bodiesFaulted(Stage);                    \
   template bool World<S>::respondToContacts();                     \
   template bool World<S>::pushGrassOnHost(const GrassPushers<S>&); \

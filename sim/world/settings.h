@@ -28,6 +28,12 @@ inline constexpr Exact kContactPushMaxVelocity{3, 1};
 /// small hop keeps its row and its warm-start impulses. The world adds each body's motion in
 /// the tick, (|v| + |w| r + |g| dt) dt, for continuous collision.
 inline constexpr Exact kSpeculativeDistance{1, 50};
+/// The most contacts one tick may hold, bodies against bodies and against the terrain together
+/// (2^18: about 100 MB of contacts and solver rows at fx32). A pile of 1,024 bodies resting on
+/// each other holds tens of thousands; past this, bodies are heaped inside one another (128
+/// compounds of 16 boxes placed at one spot made 8 million, and ran the machine out of memory),
+/// and the tick stops with an error naming the count instead.
+inline constexpr int64_t kMaxContacts = int64_t(1) << 18;
 /// Overlap above which a body counts as being pushed out (m, Box2D's b2_linearSlop). The solver
 /// itself has no slop (soft contacts settle to their load's give); only the sleep rule reads it:
 /// a body with a contact deeper than this is moving at up to kContactPushMaxVelocity, a motion

@@ -157,6 +157,7 @@ class World final : public SimWorld {
   void spawnBody(int32_t templateBody, const InputVec3& at);
   void dropCachedImpulses(size_t body);
   void detectContacts();
+  void failWithTooManyContacts(int32_t body);  ///< body -1: not one pair's (the terrain pass)
   bool respondToContacts();
   /// The contact rows (prepareContacts), in ranges of whole body pairs on the pool.
   void prepareContactRows();

@@ -118,6 +118,7 @@ bool World<S>::windStage() {
 template <class S>
 bool World<S>::collisionStage() {
   detectContacts();
+  if (failed_) return false;  // too many contacts (failWithTooManyContacts)
   return !bodiesFaulted(Stage::Collision);
 }
 
