@@ -279,12 +279,19 @@ TEST_F(SweepScaleOut, WhatAReviewerBrokeStaysFixed) {
   const std::string variant = readFile(file("shards/shard-000003.sgs"));
   const size_t textBytes = size_t(uint8_t(variant[8])) | size_t(uint8_t(variant[9])) << 8;
   for (const auto& [key, value] :
-       std::vector<std::pair<std::string, json>>{{"steps", -5}, {"summary.ticks", -1}, {"summary.ticks", 0}}) {
+       std::vector<std::pair<std::string, json>>{{"steps", -5},
+                                                 {"summary.ticks", -1},
+                                                 {"summary.ticks", 0},
+                                                 // Text that reaches the terminal and sweep.csv (an
+                                                 // independent pass, 2026-11-29): a newline and a
+                                                 // colour escape, and a page of it.
+                                                 {"fault", "tick 3\n\x1b[31mred"},
+                                                 {"fault", std::string(100000, 'x')}}) {
     json h = json::parse(variant.substr(12, textBytes));
-    if (key == "steps")
-      h["steps"] = value;
-    else
+    if (key == "summary.ticks")
       h["summary"]["ticks"] = value;
+    else
+      h[key] = value;
     fs::remove_all(file("forged"));
     fs::copy(file("shards"), file("forged"), fs::copy_options::recursive);
     const std::vector<uint8_t> bytes = sweep::shardBytes(h, {});
@@ -293,6 +300,26 @@ TEST_F(SweepScaleOut, WhatAReviewerBrokeStaysFixed) {
     const CliResult r = merge("forged", "forged-out");
     EXPECT_EQ(r.exitCode, 2) << key << " = " << value << "\n" << r.describe();
     EXPECT_NE(r.err.find("shard-000003.sgs: $." + key), std::string::npos) << r.err;
+    EXPECT_TRUE(isOneLine(r.err)) << r.describe();
+  }
+  // A reference shard's patch count: at least one, at most its scenario's field (10^12 and 0
+  // merged before).
+  const std::vector<uint8_t> referenceBytes = [&] {
+    const std::string b = readFile(file("shards/shard-000000.sgs"));
+    return std::vector<uint8_t>(b.begin(), b.end());
+  }();
+  const sweep::Shard reference = sweep::parseShard(referenceBytes, "shard-000000.sgs", uint64_t(1) << 30, true);
+  for (const int64_t patches : {int64_t(0), int64_t(1000000000000)}) {
+    json h = reference.header;
+    h["patches"] = patches;
+    fs::remove_all(file("forged"));
+    fs::copy(file("shards"), file("forged"), fs::copy_options::recursive);
+    const std::vector<uint8_t> bytes = sweep::shardBytes(h, reference.payload);
+    std::ofstream(file("forged/shard-000000.sgs"), std::ios::binary | std::ios::trunc)
+        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    const CliResult r = merge("forged", "forged-out");
+    EXPECT_EQ(r.exitCode, 2) << patches << " patches\n" << r.describe();
+    EXPECT_NE(r.err.find("shard-000000.sgs: $.patches"), std::string::npos) << r.err;
   }
 }
 

@@ -20,6 +20,7 @@
 #include "replay/progress.h"
 #include "replay/recorder.h"
 #include "replay/scenario_files.h"
+#include "sim/scenario/json_bounds.h"
 #include "sim/state/byte_order.h"
 
 namespace sg::sweep {
@@ -176,11 +177,15 @@ json modelErrorJson(const ModelError& e) {
   return {bitsOf(e.tipRms), bitsOf(e.tipMax), bitsOf(e.seconds), bitsOf(e.bodyRms), bitsOf(e.bodyMax)};
 }
 
+/// The longest fault message a variant's shard may carry (bytes).
+constexpr size_t kMaxFaultBytes = 1024;
+
 /// The reference results of scenario `s` from its shard's header and payload.
 void takeReference(Plan& plan, size_t s, const Shard& shard, const std::string& file, bool withObservations) {
   ScenarioRun& sc = plan.scenarios[s];
   const json& h = shard.header;
-  sc.patches = ranged(h, "patches", file, "$", 0, int64_t(1) << 40);
+  // A world's patches are at most its field's (fewer with a level-of-detail window), at least one.
+  sc.patches = ranged(h, "patches", file, "$", 1, sc.reference.field.patchesX * sc.reference.field.patchesZ);
   sc.bodies = ranged(h, "bodies", file, "$", 0, kMaxBodies);
   const int64_t states = plan.ticks / plan.interval + 1;
   sc.statesCompared = ranged(h, "statesCompared", file, "$", states, states);
@@ -532,7 +537,14 @@ bool mergeShards(Plan& plan, const std::string& fingerprint, const std::string& 
       Row& row = plan.rows[size_t(job - referenceJobs(plan))];
       // A variant steps at most dt_ref / dt_min = 1/240 / 1e-5 own ticks per reference tick.
       row.steps = ranged(s.header, "steps", file, "$", 0, plan.ticks * 420);
+      // A job writes its world's one-line error here (under 200 bytes); a shard's text reaches the
+      // terminal and sweep.csv, so a control character or a page of text in it is refused, not
+      // printed (an independent pass merged a fault with a newline and a colour escape).
       row.fault = field<std::string>(s.header, "fault", file, "$");
+      if (row.fault.size() > kMaxFaultBytes || escapeControl(row.fault) != row.fault)
+        failInput(file, "$.fault",
+                  "a one-line fault message of at most " + std::to_string(kMaxFaultBytes) +
+                      " bytes without control characters");
       row.runMs.clear();
       const json& runMs = s.header.value("runMs", json());
       if (!runMs.is_array() || runMs.size() > size_t(plan.options.repeats))
