@@ -1,6 +1,7 @@
 #include "replay/player.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "replay/physics_devices.h"
 #include "replay/scenario_files.h"
@@ -79,6 +80,26 @@ Player::Player(const sgr::Recording& recording, int threads, const VariantSettin
   largestStateBytes_ = largestState(world_->counts());
   // Spawn commands add bodies up to kMaxBodies: commands may name those indices too.
   const int64_t bodies = bodyIndexLimit(size_t(world_->counts().bodies));
+  // Camera positions and command values within the scalar's coordinate range, as a track's are
+  // (validateInputTrack): a forged camera at 2^30 m wrapped the level-of-detail window, and
+  // `replay --to` exported the diverged state with exit 0 (an independent pass, 2026-11-29).
+  const double limit = dispatchScalar(scenario_.scalar, []<class S>() { return ScalarTraits<S>::maxCoordinate; });
+  const auto within = [&](const InputVec3& v) {
+    for (const int64_t raw : {v.x, v.y, v.z})
+      if (!(std::fabs(double(raw) / 4294967296.0) <= limit)) return false;
+    return true;
+  };
+  const std::string rangeText = std::string(" within the ") + scalarName(scenario_.scalar) +
+                                " range (|value| <= " + std::to_string(int64_t(std::min(limit, 2147483647.0))) + " m)";
+  for (const sgr::InputRecord& in : recording.inputs) {
+    if (in.input.hasCamera && !within(in.input.camera))
+      throw sgr::RecordingError(recording.file, in.offset,
+                                "camera coordinates" + rangeText + " at tick " + std::to_string(in.tick));
+    for (const BodyCommand& c : in.input.bodies)
+      if (!within(c.value))
+        throw sgr::RecordingError(recording.file, in.offset,
+                                  "command values" + rangeText + " at tick " + std::to_string(in.tick));
+  }
   for (const sgr::InputRecord& in : recording.inputs)
     for (const BodyCommand& c : in.input.bodies)
       if (c.body >= bodies)

@@ -102,17 +102,19 @@ std::vector<uint8_t> withHead(const std::vector<uint8_t>& head) {
   return assemble(chunks);
 }
 
-/// tiny.sgr's HEAD without hashes or snapshots, and an INPT at tick 0 whose commands (2^30 m/s,
-/// twice) overflow the ball's velocity in Q32.32 as they are applied: a replay faults at once.
+/// tiny.sgr's HEAD without hashes or snapshots, and an INPT at tick 0 whose commands (the largest
+/// value fx32 takes, 536,870,911 m/s, five times) overflow the ball's velocity in Q32.32 as they are
+/// applied: a replay faults at once. (Each value alone is in range: a recording whose values are
+/// not is refused when it is opened.)
 std::vector<Chunk> faultingAtTickZero() {
   sgr::Header h = tinyHeader();
   h.checkEvery = 0;
   h.snapshotEvery = 0;
   std::vector<Chunk> chunks{{sgr::ChunkType::Head, sgr::encodeHead(h)}};
   TickInput blast;
-  for (int twice = 0; twice < 2; ++twice)
-    blast.bodies.push_back(
-        BodyCommand{0, BodyCommandKind::AddVelocity, InputVec3{int64_t(1) << 62, int64_t(1) << 62, int64_t(1) << 62}});
+  const int64_t largest = int64_t(536870911) << 32;
+  for (int k = 0; k < 5; ++k)
+    blast.bodies.push_back(BodyCommand{0, BodyCommandKind::AddVelocity, InputVec3{largest, largest, largest}});
   chunks.push_back({sgr::ChunkType::Input, sgr::encodeInput(0, blast, TickInput{})});
   return chunks;
 }

@@ -5,6 +5,8 @@
 #include <zstd.h>
 #include <algorithm>
 #include <array>
+#include <cinttypes>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <memory>
@@ -282,6 +284,13 @@ void parseInput(Recording& r, Cursor& c, TickInput& camera, Ticks& ticks) {
 }  // namespace
 
 namespace {
+/// A state hash as the tools print it: 16 hex digits.
+std::string hashText(uint64_t h) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016" PRIx64, h);
+  return text;
+}
+
 /// The magic and the version: the same errors whether the whole file or only its first bytes
 /// are at hand (readRecording checks them before reading the rest).
 void checkPreamble(std::span<const uint8_t> all, uint64_t fileSize, const std::string& file) {
@@ -441,6 +450,17 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
   }
   if (!haveHead) throw RecordingError(file, at, "the HEAD chunk (the file ends early)");
   if (!r.end && !r.truncated) truncate(at, "the END chunk (the recording was not finished)");
+  // A snapshot and a check of the same tick hash the same state. A snapshot spliced in from
+  // another run (its own hash and checksum intact) drew that run's state in `render` with exit 0,
+  // and `replay --verify` reported the mismatch and then "matches" (an independent pass).
+  for (size_t k = 0, s = 0; s < r.snapshots.size(); ++s) {
+    while (k < r.checks.size() && r.checks[k].tick < r.snapshots[s].tick) ++k;
+    if (k < r.checks.size() && r.checks[k].tick == r.snapshots[s].tick && r.checks[k].hash != r.snapshots[s].hash)
+      throw RecordingError(file, r.snapshots[s].offset,
+                           "a snapshot whose hash is its tick's check hash (" + hashText(r.checks[k].hash) +
+                               " at tick " + std::to_string(r.snapshots[s].tick) + "), got " +
+                               hashText(r.snapshots[s].hash));
+  }
   return r;
 }
 

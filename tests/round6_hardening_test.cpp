@@ -1,0 +1,84 @@
+// Hostile recordings an independent pass found read as if sound (2026-11-29, round 6;
+// docs/robustness.md): a snapshot whose hash is not its tick's check, and camera positions beyond
+// the scalar's range. Each must be one line naming the byte, and exit 2.
+#include <gtest/gtest.h>
+#include <xxhash.h>
+
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "tests/cli_support.h"
+#include "tests/test_support.h"
+
+namespace sg {
+namespace {
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+/// Calls `edit(bytes, payloadAt)` on the first chunk of `type` (4 ASCII bytes) that `edit` takes
+/// (returns true for), then recomputes that chunk's XXH3 checksum. Chunks: type, u32 length,
+/// payload, u64 checksum (little-endian on the machines that run this). False if none was taken.
+bool forgeChunk(std::vector<uint8_t>& bytes, const char* type,
+                const std::function<bool(std::vector<uint8_t>&, size_t)>& edit) {
+  for (size_t at = 12; at + 8 <= bytes.size();) {
+    uint32_t length = 0;
+    std::memcpy(&length, bytes.data() + at + 4, 4);
+    if (std::memcmp(bytes.data() + at, type, 4) == 0 && edit(bytes, at + 8)) {
+      const uint64_t sum = XXH3_64bits(bytes.data() + at, 8 + size_t(length));
+      std::memcpy(bytes.data() + at + 8 + length, &sum, 8);
+      return true;
+    }
+    at += 16 + size_t(length);
+  }
+  return false;
+}
+
+TEST(Round6Hardening, ASnapshotWhoseHashIsNotItsTicksCheckIsRefused) {
+  // A snapshot spliced in from another run keeps its own hash and checksum: `render` drew that
+  // run's state with exit 0, and `replay --verify` printed the mismatch and then "matches".
+  TempDir dir;
+  const std::string rec = dir.file("t.sgr");
+  ASSERT_EQ(runCli("record " + quote(test::sourcePath("tests/data/sgr/tiny.json")) +
+                   " --ticks 24 --threads 1 --snapshot-every 10 -o " + quote(rec))
+                .exitCode,
+            0);
+  std::vector<uint8_t> bytes = readBytes(rec);
+  ASSERT_TRUE(forgeChunk(bytes, "SNAP", [](std::vector<uint8_t>& b, size_t payload) {
+    b[payload + 8] ^= 1;  // the snapshot hash, after its tick
+    return true;
+  }));
+  writeBytes(rec, bytes);
+  for (const std::string& command : {"replay " + quote(rec) + " --verify", "replay " + quote(rec) + " --to 12",
+                                     "render " + quote(rec) + " --ticks 12 -o " + quote(dir.file("frames"))}) {
+    const CliResult r = runCli(command);
+    EXPECT_EQ(r.exitCode, 2) << command << "\n" << r.describe();
+    EXPECT_TRUE(isOneLine(r.err)) << r.err;
+    EXPECT_TRUE(contains(r.err, "expected a snapshot whose hash is its tick's check hash")) << r.err;
+  }
+}
+
+TEST(Round6Hardening, CameraCoordinatesBeyondTheScalarsRangeAreRefused) {
+  // A camera at 2^30 m wrapped the level-of-detail window, and `replay --to 5 --export-state`
+  // wrote the diverged state with exit 0 (no hash at tick 5 to catch it).
+  TempDir dir;
+  std::vector<uint8_t> bytes = readBytes(test::sourcePath("scenarios/recordings/lod-crossing-fx32.sgr"));
+  ASSERT_TRUE(forgeChunk(bytes, "INPT", [](std::vector<uint8_t>& b, size_t payload) {
+    if ((b[payload + 8] & 1) == 0 || b[payload + 9] != 1) return false;  // flags, then the camera flag
+    const int64_t far = int64_t(1) << 62;                                // 2^30 m in Q32.32
+    std::memcpy(b.data() + payload + 10, &far, 8);                       // x
+    return true;
+  }));
+  const std::string rec = dir.file("far.sgr");
+  writeBytes(rec, bytes);
+  const CliResult r = runCli("replay " + quote(rec) + " --to 5 --export-state " + quote(dir.file("x.json")));
+  EXPECT_EQ(r.exitCode, 2) << r.describe();
+  EXPECT_TRUE(isOneLine(r.err)) << r.err;
+  EXPECT_TRUE(contains(r.err, "expected camera coordinates within the fx32 range")) << r.err;
+  EXPECT_FALSE(fs::exists(dir.file("x.json")));
+}
+
+}  // namespace
+}  // namespace sg
