@@ -4,6 +4,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "sim/scenario/json_bounds.h"
+
 namespace sg {
 namespace {
 [[noreturn]] void bad(const std::string& setting, const std::string& expected) {
@@ -16,6 +18,12 @@ const char* bodyBroadphaseName(BodyBroadphase b) { return b == BodyBroadphase::S
 
 VariantSettings VariantSettings::parse(const std::string& text) {
   VariantSettings v;
+  // A NUL (or another control character) inside the text cut the error line short where it was
+  // printed as a C string, naming a valid item as the fault (a recording's header, an independent
+  // pass): refused whole, escaped.
+  for (const char ch : text)
+    if ((static_cast<unsigned char>(ch) < 0x20 && ch != ' ' && ch != '\t') || ch == 0x7f)
+      bad("'" + echoText(escapeControl(text)) + "'", "printable KEY=VALUE items (a control character inside)");
   // "interp=2," or "interp=2,,scalar=fx16" ran as "interp=2" (commas became spaces): an empty
   // item between commas is a typo, as `render --debug 'particles,'` already says.
   {

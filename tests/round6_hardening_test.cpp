@@ -7,9 +7,12 @@
 #include <cstdint>
 #include <cstring>
 #include <functional>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "replay/variant.h"
 #include "tests/cli_support.h"
 #include "tests/test_support.h"
 
@@ -78,6 +81,45 @@ TEST(Round6Hardening, CameraCoordinatesBeyondTheScalarsRangeAreRefused) {
   EXPECT_TRUE(isOneLine(r.err)) << r.err;
   EXPECT_TRUE(contains(r.err, "expected camera coordinates within the fx32 range")) << r.err;
   EXPECT_FALSE(fs::exists(dir.file("x.json")));
+}
+
+TEST(Round6Hardening, RequestsThatWereIgnoredAreRefused) {
+  // Each of these exited 0 having done less than was asked.
+  TempDir dir;
+  const std::string rec = quote(test::sourcePath("scenarios/recordings/thesis-bodies-fx32.sgr"));
+  const std::string tiny = quote(test::sourcePath("tests/data/sgr/tiny.json"));
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"replay " + rec + " --info --to 5", "--to excludes --info"},
+      {"replay " + rec + " --info --export-state " + quote(dir.file("i.bin")), "--export-state excludes --info"},
+      {"replay " + rec + " --info --verify", "--verify excludes --info"},
+      {"diff " + rec + " " + rec + " --heatmap-tick abc", "--heatmap-tick requires --heatmap"},
+      {"record " + tiny + " --ticks 2 -o " + quote(dir.file("v.sgr")) + " --variant scalar=fx16 --variant scalar=fx32",
+       "--variant scalar: expected each setting once across the --variant options"}};
+  for (const auto& [command, phrase] : cases) {
+    const CliResult r = runCli(command);
+    EXPECT_EQ(r.exitCode, 2) << command << "\n" << r.describe();
+    EXPECT_TRUE(isOneLine(r.err)) << r.err;
+    EXPECT_TRUE(contains(r.err, phrase)) << command << "\n" << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir.file("i.bin")));
+  EXPECT_FALSE(fs::exists(dir.file("v.sgr")));
+  // Different keys in two --variant options still combine.
+  EXPECT_EQ(runCli("record " + tiny + " --ticks 2 -o " + quote(dir.file("w.sgr")) +
+                   " --variant scalar=fx16 --variant interp=1")
+                .exitCode,
+            0);
+}
+
+TEST(Round6Hardening, AControlCharacterInVariantTextIsNamedWhole) {
+  // A NUL in a recording header's variant cut the message at it, so it named "interp=1".
+  try {
+    (void)VariantSettings::parse(std::string("scalar=fx32 interp=1\0junk", 25));
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_TRUE(contains(what, "'scalar=fx32 interp=1\\x00junk'")) << what;
+    EXPECT_TRUE(contains(what, "a control character inside")) << what;
+  }
 }
 
 }  // namespace

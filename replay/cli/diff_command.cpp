@@ -278,9 +278,12 @@ void addDiffCommand(CLI::App& app, int* exitCode) {
   cmd->add_option("a", o->a, "First recording (.sgr): the reference, whose ticks are reported")->required();
   cmd->add_option("b", o->b, "Second recording (.sgr) of a field the same size (other settings allowed)")->required();
   cmd->add_option("--csv", o->csv, "Write one row per compared tick to this CSV file");
-  cmd->add_option("--heatmap", o->heatmap, "Write a PNG heat map of the tip distance over the meadow");
+  CLI::Option* heatmap =
+      cmd->add_option("--heatmap", o->heatmap, "Write a PNG heat map of the tip distance over the meadow");
+  // Without --heatmap the tick was never read, so `--heatmap-tick abc` passed (an independent pass).
   cmd->add_option("--heatmap-tick", o->heatmapTick,
-                  "Tick of the heat map: a tick, 'last' (default) or 'max' (largest tip error)");
+                  "Tick of the heat map (with --heatmap): a tick, 'last' (default) or 'max' (largest tip error)")
+      ->needs(heatmap);
   cmd->add_option("--threads", o->threads, "Worker threads per replay (results are identical for any count)")
       ->check(CLI::Range(1, 256));
   cmd->add_flag("--json", o->json, "Machine-readable output, with the per-tick series");

@@ -70,7 +70,13 @@ int record(const RecordOptions& o) {
   std::unique_ptr<SimWorld> world;
   try {
     VariantSettings variant;
-    for (const std::string& v : o.variants) variant = VariantSettings::parse(v).over(variant);
+    for (const std::string& v : o.variants) {
+      // Two --variant options naming one key: the last won silently (an independent pass).
+      const VariantSettings one = VariantSettings::parse(v);
+      if (const std::string keys = sharedKeys(one, variant); !keys.empty())
+        throw std::invalid_argument(keys + ": expected each setting once across the --variant options");
+      variant = one.over(variant);
+    }
     VariantSettings flags;
     for (const auto& [key, value] : o.shorthands) {
       if (value.empty()) continue;  // not given (a given empty value is refused by the parser)

@@ -231,18 +231,26 @@ void addReplayCommand(CLI::App& app, int* exitCode) {
   CLI::App* cmd = app.add_subcommand("replay", "Play a .sgr recording back: verify its hashes, seek, export a state");
   cmd->add_option("recording", o->file, "Recording (.sgr)")->required();
   cmd->add_flag("--verify", o->verify, "Recompute every recorded hash; report the first tick that differs (exit 1)");
-  cmd->add_option("--to", o->to, "Seek to this tick through the nearest snapshot")
-      ->check(CLI::Range(int64_t(0), kMaxTick));
-  cmd->add_option("--export-state", o->exportState,
-                  "Write the state reached to this file: NAME.json the documented JSON form, any other name the binary "
-                  "state (docs/state-format.md)");
+  CLI::Option* verify = cmd->get_option("--verify");
+  CLI::Option* to = cmd->add_option("--to", o->to, "Seek to this tick through the nearest snapshot")
+                        ->check(CLI::Range(int64_t(0), kMaxTick));
+  CLI::Option* exportState = cmd->add_option(
+      "--export-state", o->exportState,
+      "Write the state reached to this file: NAME.json the documented JSON form, any other name the binary "
+      "state (docs/state-format.md)");
   cmd->add_option("--threads", o->threads, "Worker threads (the result is identical for any count)")
       ->check(CLI::Range(1, 256));
   cmd->add_option("--physics", o->physics,
                   "Where the grass stages run: cpu, gpu or gpu-readback (the state is identical, so the recorded "
                   "hashes verify on any path; docs/gpu-physics.md)")
       ->check(CLI::IsMember({"cpu", "gpu", "gpu-readback"}));
-  cmd->add_flag("--info", o->info, "Print what the recording holds without simulating");
+  // --info simulates nothing: with a seek, a verification or an export it ignored them, exit 0 (an
+  // independent pass, 2026-11-29).
+  cmd->add_flag("--info", o->info,
+                "Print what the recording holds without simulating (alone: no --to, --verify or --export-state)")
+      ->excludes(verify)
+      ->excludes(to)
+      ->excludes(exportState);
   cmd->add_flag("--json", o->json, "Machine-readable output");
   cmd->footer(
       "Exit codes: 0 ok, 1 hash mismatch or simulation fault, 2 bad input, 3 recording cut off before END "
