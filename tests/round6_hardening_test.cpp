@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "replay/variant.h"
+#include "sim/scenario/json_bounds.h"
 #include "tests/cli_support.h"
 #include "tests/test_support.h"
 
@@ -39,15 +40,22 @@ bool forgeChunk(std::vector<uint8_t>& bytes, const char* type,
   return false;
 }
 
+/// tests/data/sgr/tiny.json recorded for 24 ticks on one thread into `dir` as `name`, with
+/// `options`; "" when the recording failed.
+std::string recordTiny(TempDir& dir, const std::string& name, const std::string& options) {
+  const std::string rec = dir.file(name);
+  const CliResult r = runCli("record " + quote(test::sourcePath("tests/data/sgr/tiny.json")) +
+                             " --ticks 24 --threads 1 -o " + quote(rec) + options);
+  EXPECT_EQ(r.exitCode, 0) << r.describe();
+  return r.exitCode == 0 ? rec : std::string();
+}
+
 TEST(Round6Hardening, ASnapshotWhoseHashIsNotItsTicksCheckIsRefused) {
   // A snapshot spliced in from another run keeps its own hash and checksum: `render` drew that
   // run's state with exit 0, and `replay --verify` printed the mismatch and then "matches".
   TempDir dir;
-  const std::string rec = dir.file("t.sgr");
-  ASSERT_EQ(runCli("record " + quote(test::sourcePath("tests/data/sgr/tiny.json")) +
-                   " --ticks 24 --threads 1 --snapshot-every 10 -o " + quote(rec))
-                .exitCode,
-            0);
+  const std::string rec = recordTiny(dir, "t.sgr", " --snapshot-every 10");
+  ASSERT_FALSE(rec.empty());
   std::vector<uint8_t> bytes = readBytes(rec);
   ASSERT_TRUE(forgeChunk(bytes, "SNAP", [](std::vector<uint8_t>& b, size_t payload) {
     b[payload + 8] ^= 1;  // the snapshot hash, after its tick
@@ -108,6 +116,41 @@ TEST(Round6Hardening, RequestsThatWereIgnoredAreRefused) {
                    " --variant scalar=fx16 --variant interp=1")
                 .exitCode,
             0);
+}
+
+TEST(Round6Hardening, RenderWarnsOfACutRecording) {
+  // replay, compare and diff warn of a recording cut before its END and exit 3; render drew it
+  // silently with exit 0.
+  TempDir dir;
+  const std::string rec = recordTiny(dir, "cut.sgr", "");
+  ASSERT_FALSE(rec.empty());
+  std::vector<uint8_t> bytes = readBytes(rec);
+  bytes.resize(bytes.size() - 5);  // inside the END chunk
+  writeBytes(rec, bytes);
+  const CliResult r =
+      runCli("render " + quote(rec) + " --ticks 5 --size 64x48 --msaa 0 -o " + quote(dir.file("frames")));
+  EXPECT_EQ(r.exitCode, 3) << r.describe();
+  EXPECT_TRUE(isOneLine(r.err)) << r.err;
+  EXPECT_TRUE(contains(r.err, "simgrass render: warning: ")) << r.err;
+  EXPECT_TRUE(fs::exists(dir.file("frames/frame-000005.png"))) << r.describe();
+}
+
+TEST(Round6Hardening, BidirectionalControlsAreEscapedInMessages) {
+  // A scenario named with U+202E (right-to-left override) reversed the rest of its line on a
+  // terminal: the bidi formatting characters are escaped byte by byte, other text kept.
+  EXPECT_EQ(escapeControl("a\xe2\x80\xae"
+                          "b"),
+            "a\\xe2\\x80\\xaeb");                                                            // U+202E
+  EXPECT_EQ(escapeControl("\xe2\x81\xa6x\xe2\x81\xa9"), "\\xe2\\x81\\xa6x\\xe2\\x81\\xa9");  // U+2066, U+2069
+  EXPECT_EQ(escapeControl("\xe2\x80\x8f\xd8\x9c"), "\\xe2\\x80\\x8f\\xd8\\x9c");             // U+200F, U+061C
+  EXPECT_EQ(escapeControl("\xe2\x80\x94 caf\xc3\xa9"), "\xe2\x80\x94 caf\xc3\xa9");          // an em dash, an e acute
+  TempDir dir;
+  const std::string scenario =
+      dir.write("rlo.json", "{\"name\": \"x\xe2\x80\xaey\", \"field\": {\"patchesX\": 2, \"patchesZ\": 2}}");
+  const CliResult r = runCli("run " + quote(scenario) + " --ticks 1");
+  EXPECT_EQ(r.exitCode, 0) << r.describe();
+  EXPECT_TRUE(contains(r.out, "x\\xe2\\x80\\xaey")) << r.out;
+  EXPECT_FALSE(contains(r.out, "\xe2\x80\xae")) << r.out;
 }
 
 TEST(Round6Hardening, AControlCharacterInVariantTextIsNamedWhole) {

@@ -39,6 +39,18 @@ void appendByte(std::string& out, unsigned char c) {
 
 // Escapes what a terminal or a log would act on or mangle: C0 controls and DEL, the C1 controls
 // U+0080..U+009F (U+009B is a CSI on some terminals), and bytes that are not valid UTF-8.
+/// Whether the UTF-8 sequence is a bidirectional formatting character: U+061C, U+200E, U+200F,
+/// U+202A to U+202E and U+2066 to U+2069. They reorder the text printed after them (a scenario
+/// named with U+202E, right-to-left override, reversed the rest of its error line: an independent
+/// pass), so they are escaped as the controls are.
+bool isBidiControl(std::string_view seq) {
+  const auto b = [&](size_t k) { return static_cast<unsigned char>(seq[k]); };
+  if (seq.size() == 2) return b(0) == 0xD8 && b(1) == 0x9C;
+  if (seq.size() != 3 || b(0) != 0xE2) return false;
+  if (b(1) == 0x80) return b(2) == 0x8E || b(2) == 0x8F || (b(2) >= 0xAA && b(2) <= 0xAE);
+  return b(1) == 0x81 && b(2) >= 0xA6 && b(2) <= 0xA9;
+}
+
 void appendEscaped(std::string& out, std::string_view s) {
   for (size_t i = 0; i < s.size();) {
     const auto c = static_cast<unsigned char>(s[i]);
@@ -59,6 +71,8 @@ void appendEscaped(std::string& out, std::string_view s) {
     } else if (n == 2 && c == 0xC2 && static_cast<unsigned char>(s[i + 1]) < 0xA0) {
       appendByte(out, c);  // a C1 control
       appendByte(out, static_cast<unsigned char>(s[i + 1]));
+    } else if (isBidiControl(s.substr(i, n))) {
+      for (size_t k = 0; k < n; ++k) appendByte(out, static_cast<unsigned char>(s[i + k]));
     } else {
       out.append(s.substr(i, n));
     }

@@ -33,7 +33,8 @@ std::optional<size_t> findExcessNesting(std::string_view text, int maxDepth = kM
 /// recursion and stopping once it exceeds `limit` (returns limit + 1 then).
 int jsonDepth(const nlohmann::json& value, int limit = kMaxJsonDepth);
 
-/// `text` with every control character escaped (\n, \r, \t, \xNN; also DEL and the C1 controls)
+/// `text` with every control character escaped (\n, \r, \t, \xNN; also DEL, the C1 controls and
+/// the bidirectional formatting characters such as U+202E, byte by byte)
 /// and every byte that is not valid UTF-8 as \xNN, whole: what a
 /// one-line message prints of a file name or an error text, so that a newline cannot split it.
 std::string escapeControl(std::string_view text);

@@ -321,6 +321,11 @@ int render(const RenderOptions& o) {
       if (range->last > recording->lastTick())
         return fail(kExitBadInput, "--ticks: the recording " + o.input + " ends at tick " +
                                        std::to_string(recording->lastTick()) + ", got " + o.ticks);
+      // As replay, compare and diff say it (exit 3 below): a cut recording rendered silently.
+      if (recording->truncated)
+        printError(
+            "simgrass render: warning: %s: byte %" PRIu64 ": expected %s; rendering the %" PRId64 " ticks before it",
+            o.input.c_str(), recording->truncatedAt, recording->truncatedExpected.c_str(), recording->lastTick());
     } else {
       scenario = loadScenarioFile(o.input, &scenarioFiles);
       ownWorld = makeWorld(scenario, o.threads, physicalMemoryBytes());
@@ -532,6 +537,7 @@ int render(const RenderOptions& o) {
                 median(renderMs), renderer->scene().tufts.size(), median(extractMs), median(simMsPerTick));
     if (!o.contactSheet.empty()) std::printf("sheet      %s\n", o.contactSheet.c_str());
   }
+  if (code == kExitOk && recording && recording->truncated) code = kExitTruncated;
   return code;
 }
 }  // namespace
@@ -567,7 +573,9 @@ void addRenderCommand(CLI::App& app, int* exitCode) {
                   "Where the grass stages run: cpu, gpu (in the renderer's context: the frames draw the tops "
                   "from the device, nothing copied back) or gpu-readback (docs/gpu-physics.md)");
   cmd->add_flag("--json", o->json, "Machine-readable output");
-  cmd->footer("Exit codes: 0 ok, 1 simulation fault or no OpenGL context, 2 bad input.");
+  cmd->footer(
+      "Exit codes: 0 ok, 1 simulation fault or no OpenGL context, 2 bad input, 3 recording cut off before END "
+      "(rendered up to the cut).");
   cmd->callback([o, exitCode] { *exitCode = render(*o); });
 }
 }  // namespace sg
