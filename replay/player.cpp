@@ -147,8 +147,8 @@ StepResult Player::seek(int64_t target, const std::function<void(int64_t)>& prog
         world_->restoreState(state);
       } catch (const StateError& e) {
         throw sgr::RecordingError(recording_.file, snap->offset,
-                                  "a snapshot of this scenario's state (state byte " + std::to_string(e.offset()) +
-                                      ": expected " + e.what() + ")");
+                                  // e.what() is "byte N: expected ..." (it said "state byte N: expected byte N: ...").
+                                  std::string("a snapshot of this scenario's state (state ") + e.what() + ")");
       }
       if (world_->stateHash() != snap->hash)
         throw sgr::RecordingError(recording_.file, snap->offset, "a snapshot whose state matches its hash");

@@ -206,6 +206,18 @@ TEST(RenderObj, VertexLinesHaveNoTrailingJunk) {
   EXPECT_EQ(objError("v 0 0 0\nvn 0 0 1 0\n"), "m.obj:2: expected 'vn x y z', got 4 values");
 }
 
+TEST(RenderObj, AFaceCornerNamesWhatIsWrongWithIt) {
+  // "f 1/// 2 3" said "a normal index in 1..0", an empty range (an independent pass, 2026-11-29).
+  const std::string three = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  EXPECT_EQ(objError(three + "f 1/// 2 3\n"), "m.obj:4: expected a face corner v, v/vt, v//vn or v/vt/vn, got '1///'");
+  EXPECT_EQ(objError(three + "f 1//1 2 3\n"),
+            "m.obj:4: expected no normal index (no vn line comes before this face), got '1//1'");
+  EXPECT_EQ(objError(three + "f 1/1 2 3\n"),
+            "m.obj:4: expected no texture index (no vt line comes before this face), got '1/1'");
+  EXPECT_EQ(objError(three + "vn 0 0 1\nf 1//2 2 3\n"), "m.obj:5: expected a normal index in 1..1, got '1//2'");
+  EXPECT_EQ(objError(three + "vn 0 0 1\nf 1//1 2//1 3//1\n"), "");
+}
+
 TEST(RenderObj, NumbersOutOfRangeOrNotFiniteAreRefused) {
   // from_chars reports overflow; NaN and infinity parse but are refused; so is a coordinate past
   // 1e6 m (its normal sums would overflow float).

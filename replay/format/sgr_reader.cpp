@@ -435,6 +435,13 @@ Recording parseRecording(std::vector<uint8_t> bytes, const std::string& file) {
         const int64_t reachable =
             ticks.lastNamed > kMaxTick - 1 - kMaxTickGap ? kMaxTick - 1 : ticks.lastNamed + kMaxTickGap;
         const int64_t lastAllowed = std::min({e.faulted ? nextDue : nextDue - 1, kMaxTick - 1, reachable});
+        // No final tick fits when the file names a tick (an input whose step was taken) at or past
+        // the next check or snapshot due, which is missing: "a final tick from 31 to 30" said it
+        // backwards (an independent pass).
+        if (covered > lastAllowed && lastAllowed == nextDue - 1)
+          c.fail(at + kChunkHeaderBytes, "the check or snapshot due at tick " + std::to_string(nextDue) +
+                                             " before this END (the chunks before it take the recording to tick " +
+                                             std::to_string(covered) + " at least)");
         if (e.tick < covered || e.tick > lastAllowed)
           c.fail(at + kChunkHeaderBytes,
                  "a final tick from " + std::to_string(covered) + " to " + std::to_string(lastAllowed) +

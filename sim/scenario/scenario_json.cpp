@@ -739,8 +739,11 @@ Scenario parseScenario(const std::string& text, const std::string& sourceName, c
   if (root.contains("name")) s.name = r.string(root["name"], "$.name");
   if (root.contains("description")) r.string(root["description"], "$.description");
   if (root.contains("seed")) {
-    if (!root["seed"].is_number_unsigned()) r.failGot("$.seed", "an integer from 0 to 2^64-1", root["seed"]);
-    s.seed = root["seed"].get<uint64_t>();
+    // -0 is 0 (the parser keeps it as a signed integer: it was refused as "got 0").
+    const json& seed = root["seed"];
+    const bool negativeZero = seed.is_number_integer() && !seed.is_number_unsigned() && seed.get<int64_t>() == 0;
+    if (!seed.is_number_unsigned() && !negativeZero) r.failGot("$.seed", "an integer from 0 to 2^64-1", seed);
+    s.seed = negativeZero ? 0 : seed.get<uint64_t>();
   }
   if (root.contains("scalar")) {
     auto k = root["scalar"].is_string() ? parseScalarKind(root["scalar"].get<std::string>()) : std::nullopt;

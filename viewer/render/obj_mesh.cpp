@@ -1,5 +1,6 @@
 #include "viewer/render/obj_mesh.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <map>
@@ -122,6 +123,14 @@ bool parseObjMesh(const std::string& text, const std::string& name, ObjMesh* out
       for (size_t k = 1; k < w.size(); ++k) {
         // v, v/vt, v//vn or v/vt/vn.
         const std::string_view c = w[k];
+        if (std::count(c.begin(), c.end(), '/') > 2)  // "1///" said "a normal index in 1..0"
+          return fail("a face corner v, v/vt, v//vn or v/vt/vn, got " + quoted(c));
+        // "in 1..0" named an empty range: with no vt or vn line before the face, say that.
+        const auto range = [](const char* kind, size_t count) {
+          return count == 0 ? std::string("no ") + kind + " index (no " + (kind[0] == 't' ? "vt" : "vn") +
+                                  " line comes before this face)"
+                            : std::string("a ") + kind + " index in 1.." + std::to_string(count);
+        };
         const size_t s1 = c.find('/');
         Corner corner;
         corner.v = resolveIndex(c.substr(0, s1), v.size() / 3);
@@ -133,11 +142,10 @@ bool parseObjMesh(const std::string& text, const std::string& name, ObjMesh* out
           const size_t s2 = rest.find('/');
           const std::string_view vt = rest.substr(0, s2);
           if (!vt.empty() && resolveIndex(vt, vtCount) < 0)
-            return fail("a texture index in 1.." + std::to_string(vtCount) + ", got " + quoted(c));
+            return fail(range("texture", vtCount) + ", got " + quoted(c));
           if (s2 != std::string_view::npos) {
             corner.vn = resolveIndex(rest.substr(s2 + 1), vn.size() / 3);
-            if (corner.vn < 0)
-              return fail("a normal index in 1.." + std::to_string(vn.size() / 3) + ", got " + quoted(c));
+            if (corner.vn < 0) return fail(range("normal", vn.size() / 3) + ", got " + quoted(c));
           }
         }
         face.push_back(corner);
