@@ -81,6 +81,15 @@ std::vector<uint8_t> recordTiny(const std::string& rec, const std::string& optio
   return r.exitCode == 0 ? readBytes(rec) : std::vector<uint8_t>();
 }
 
+/// recordTiny to `rec`, then cut inside its END chunk (its last 5 bytes); false if it failed.
+bool recordCutTiny(const std::string& rec) {
+  std::vector<uint8_t> bytes = recordTiny(rec, "");
+  if (bytes.size() < 5) return false;
+  bytes.resize(bytes.size() - 5);
+  writeBytes(rec, bytes);
+  return true;
+}
+
 TEST(Round6Hardening, ASnapshotWhoseHashIsNotItsTicksCheckIsRefused) {
   // A snapshot spliced in from another run keeps its own hash and checksum: `render` drew that
   // run's state with exit 0, and `replay --verify` printed the mismatch and then "matches".
@@ -155,16 +164,24 @@ TEST(Round6Hardening, RenderWarnsOfACutRecording) {
   // silently with exit 0.
   TempDir dir;
   const std::string rec = dir.file("cut.sgr");
-  std::vector<uint8_t> bytes = recordTiny(rec, "");
-  ASSERT_FALSE(bytes.empty());
-  bytes.resize(bytes.size() - 5);  // inside the END chunk
-  writeBytes(rec, bytes);
+  ASSERT_TRUE(recordCutTiny(rec));
   const CliResult r =
       runCli("render " + quote(rec) + " --ticks 5 --size 64x48 --msaa 0 -o " + quote(dir.file("frames")));
   EXPECT_EQ(r.exitCode, 3) << r.describe();
   EXPECT_TRUE(isOneLine(r.err)) << r.err;
   EXPECT_TRUE(contains(r.err, "simgrass render: warning: ")) << r.err;
   EXPECT_TRUE(fs::exists(dir.file("frames/frame-000005.png"))) << r.describe();
+}
+
+TEST(Round6Hardening, ACutRecordingWithABadSeekIsOneLine) {
+  // `replay cut.sgr --to 29` printed the cut's warning and then the --to error: two lines.
+  TempDir dir;
+  const std::string rec = dir.file("cut.sgr");
+  ASSERT_TRUE(recordCutTiny(rec));
+  expectRefused(runCli("replay " + quote(rec) + " --to 29"), "--to: expected a tick from 0 to 24");
+  const CliResult ok = runCli("replay " + quote(rec) + " --to 5");
+  EXPECT_EQ(ok.exitCode, 3) << ok.describe();
+  EXPECT_TRUE(isOneLine(ok.err) && contains(ok.err, "simgrass replay: warning: ")) << ok.err;
 }
 
 TEST(Round6Hardening, BidirectionalControlsAreEscapedInMessages) {

@@ -60,12 +60,17 @@ int replay(const ReplayOptions& o) {
     printError("simgrass replay: %s\n", e.what());
     return kExitBadInput;
   }
-  if (rec->truncated)
-    printError("simgrass replay: warning: %s: byte %" PRIu64 ": expected %s; replaying the %" PRId64
-               " ticks before it\n",
-               o.file.c_str(), rec->truncatedAt, rec->truncatedExpected.c_str(), rec->lastTick());
+  // Said once the command will run: an error in the options or the recording is then the one line
+  // (a cut recording with a bad --to printed the warning and the error).
+  const auto warnIfCut = [&] {
+    if (rec->truncated)
+      printError("simgrass replay: warning: %s: byte %" PRIu64 ": expected %s; replaying the %" PRId64
+                 " ticks before it\n",
+                 o.file.c_str(), rec->truncatedAt, rec->truncatedExpected.c_str(), rec->lastTick());
+  };
   nlohmann::json out = headerJson(*rec);
   if (o.info) {
+    warnIfCut();
     if (o.json) {
       std::printf("%s\n", out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
     } else {
@@ -108,6 +113,7 @@ int replay(const ReplayOptions& o) {
                rec->header.startTick, last, o.to);
     return kExitBadInput;
   }
+  warnIfCut();
   int code = kExitOk;
   // Verifying a recording that stopped on a fault replays the faulting step too: the world is left
   // in that step's state, which no recorded hash describes.
