@@ -253,10 +253,17 @@ bool clipSegmentToBox(const Vec3<S>& la, const Vec3<S>& lb, const Vec3<S>& ha, S
 /// (the two triangles in one plane) is no feature, as vertexIsPlanar's vertices are not: boxes
 /// slide over planar heightmaps on their corners alone; nor is a valley's.
 template <class S>
-int creaseThroughBox(int32_t body, const Vec3<S>& ha, const Pose<S>& pose, const Vec3<S>& shift, const Terrain<S>& t,
-                     int64_t ai, int64_t aj, int64_t bi, int64_t bj, int64_t f1i, int64_t f1j, int64_t f2i, int64_t f2j,
-                     uint32_t featureB, std::vector<Contact<S>>& out) {
+int creaseThroughBox(int32_t body, const Vec3<S>& ha, const Pose<S>& pose, S reach, const Vec3<S>& shift,
+                     const Terrain<S>& t, int64_t ai, int64_t aj, int64_t bi, int64_t bj, int64_t f1i, int64_t f1j,
+                     int64_t f2i, int64_t f2j, uint32_t featureB, std::vector<Contact<S>>& out) {
   const Vec3<S> a = vertexAt(t, ai, aj), b = vertexAt(t, bi, bj);
+  // Both ends beyond the box's bounding sphere on one side of an axis (`reach`: its radius and a
+  // millimetre for rounding): the edge misses the box, and most edges of the scan do, before the
+  // two rotations below (the hills drops took 1.8 s with them for every edge, 1.1 s without edges).
+  for (int k = 0; k < 3; ++k) {
+    const S da = a[k] - pose.position[k], db = b[k] - pose.position[k];
+    if ((da >= reach && db >= reach) || (da <= -reach && db <= -reach)) return 0;
+  }
   const Vec3<S> la = pose.toLocal(a), lb = pose.toLocal(b);
   for (int k = 0; k < 3; ++k)  // both ends beyond one face: the common case, no division
     if ((la[k] >= ha[k] && lb[k] >= ha[k]) || (la[k] <= -ha[k] && lb[k] <= -ha[k])) return 0;
@@ -447,13 +454,14 @@ int collideBoxTerrain(int32_t a, const Vec3<S>& ha, const Pose<S>& pa, const Ter
   // narrower than a cell, or crossing it between two samples. Neither the corners (they hang over
   // the slopes) nor the vertices (none is inside) meet it, and a 0.2 m cube on a 1 m ridge sank
   // until its corners reached the slopes, the crest 10 cm inside it.
+  const S reach = radius + S(1) / S(1024);
   for (int64_t j = j0; j <= j1; ++j)
     for (int64_t i = i0; i <= i1; ++i) {
-      added += creaseThroughBox(a, ha, pose, shift, terrain, i, j, i + 1, j, i, j + 1, i + 1, j - 1,
+      added += creaseThroughBox(a, ha, pose, reach, shift, terrain, i, j, i + 1, j, i, j + 1, i + 1, j - 1,
                                 featureKey(kEdgeAlongX, i, j), out);
-      added += creaseThroughBox(a, ha, pose, shift, terrain, i, j, i, j + 1, i + 1, j, i - 1, j + 1,
+      added += creaseThroughBox(a, ha, pose, reach, shift, terrain, i, j, i, j + 1, i + 1, j, i - 1, j + 1,
                                 featureKey(kEdgeAlongZ, i, j), out);
-      added += creaseThroughBox(a, ha, pose, shift, terrain, i + 1, j, i, j + 1, i, j, i + 1, j + 1,
+      added += creaseThroughBox(a, ha, pose, reach, shift, terrain, i + 1, j, i, j + 1, i, j, i + 1, j + 1,
                                 featureKey(kDiagonalEdge, i, j), out);
     }
   return added;
